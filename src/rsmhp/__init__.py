@@ -1,0 +1,16 @@
+"""rsmhp: Monte-Carlo cost approximation (RS-MHP) versus nominal belief-state optimization (NBO).
+
+Reference implementation and replication pipeline for Ragi & Mittelmann, "Random-Sampling
+Monte-Carlo Tree Search Methods for Cost Approximation in Long-Horizon Optimal Control",
+IEEE Control Systems Letters 5(5), 2021.
+
+Sub-modules
+-----------
+seeding     stable, order-independent random streams (numpy SeedSequence keyed on job ids)
+sampling    tree / pruned-tree / non-overlapping trajectory sampling with likeliness
+estimators  uniform and likeliness-weighted averages, NBO
+lqg         the scalar "oven" LQG case study and all its closed forms
+parallel    joblib fan-out that honours a thread budget without oversubscribing BLAS
+"""
+
+__version__ = "0.1.0"

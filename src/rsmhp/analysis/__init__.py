@@ -1,0 +1,1 @@
+"""Aggregation of raw experiment tables into summaries, Markdown tables and report sections."""

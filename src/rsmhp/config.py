@@ -1,0 +1,121 @@
+"""Configuration checks with messages that name the field and its allowed range.
+
+:func:`check_config` validates a config mapping against ``workflow/schemas/config.schema.yaml``
+(JSON Schema draft 2020-12) and then checks the constraints a schema cannot express
+(``M <= N``, ``P.start <= P.stop``...). It reports *every* problem at once, each as
+``<dotted.path>: <value> <what is wrong> (allowed: <range>)``, and raises
+:class:`ConfigError` before any job starts. The Snakefile calls it, then snakemake's own
+``validate`` (which also fills defaults).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import yaml
+from jsonschema import Draft202012Validator
+from jsonschema.exceptions import ValidationError
+
+__all__ = ["SCHEMA_PATH", "ConfigError", "check_config", "load_schema"]
+
+SCHEMA_PATH = Path(__file__).resolve().parents[2] / "workflow" / "schemas" / "config.schema.yaml"
+
+
+class ConfigError(ValueError):
+    """The configuration is invalid; the message lists every offending field."""
+
+
+def load_schema(path: str | os.PathLike | None = None) -> dict[str, Any]:
+    with open(path or SCHEMA_PATH, encoding="utf-8") as fh:
+        return yaml.safe_load(fh)
+
+
+def _dotted(path) -> str:
+    return (
+        ".".join(str(p) if not isinstance(p, int) else f"[{p}]" for p in path).replace(".[", "[")
+        or "<root>"
+    )
+
+
+def _allowed(schema: Mapping[str, Any]) -> str:
+    """Human-readable allowed range/type of a schema node."""
+    lo = schema.get("minimum", schema.get("exclusiveMinimum"))
+    hi = schema.get("maximum", schema.get("exclusiveMaximum"))
+    if lo is not None or hi is not None:
+        left = "(" if "exclusiveMinimum" in schema or lo is None else "["
+        right = ")" if "exclusiveMaximum" in schema or hi is None else "]"
+        lo_txt = "-inf" if lo is None else lo
+        hi_txt = "inf" if hi is None else hi
+        return f"{schema.get('type', 'number')} in {left}{lo_txt}, {hi_txt}{right}"
+    if "enum" in schema:
+        return "one of " + ", ".join(map(repr, schema["enum"]))
+    if schema.get("type") == "object" and "properties" in schema:
+        return "keys " + ", ".join(schema["properties"])
+    if "type" in schema:
+        return str(schema["type"])
+    return "see workflow/schemas/config.schema.yaml"
+
+
+def _message(err: ValidationError) -> str:
+    path = _dotted(err.absolute_path)
+    if err.validator == "additionalProperties":
+        extra = sorted(set(err.instance) - set(err.schema.get("properties", {})))
+        prefix = f"{path}." if err.absolute_path else ""
+        return (
+            f"{', '.join(prefix + e for e in extra)}: unknown key (allowed at {path}: "
+            f"{', '.join(err.schema.get('properties', {}))})"
+        )
+    if err.validator == "required":
+        return f"{path}: {err.message}"
+    if err.validator in ("minItems", "maxItems"):
+        return f"{path}: {err.message}"
+    return f"{path}: {err.instance!r} is invalid ({err.message}; allowed: {_allowed(err.schema)})"
+
+
+def _cross_field(config: Mapping[str, Any]) -> list[str]:
+    """Constraints between fields that JSON Schema cannot express."""
+    problems = []
+    lqg = config.get("lqg", {}) or {}
+    grid = (lqg.get("convergence", {}) or {}).get("P", {}) or {}
+    if {"start", "stop"} <= grid.keys() and grid["start"] > grid["stop"]:
+        problems.append(
+            f"lqg.convergence.P.start: {grid['start']} is greater than lqg.convergence.P.stop "
+            f"= {grid['stop']} (allowed: start <= stop)"
+        )
+    rec = lqg.get("recording", {}) or {}
+    if {"N", "M"} <= rec.keys() and rec["M"] > rec["N"]:
+        problems.append(
+            f"lqg.recording.M: {rec['M']} is greater than lqg.recording.N = {rec['N']} "
+            f"(allowed: 1 <= M <= N; the paper prunes to M <= N trajectories)"
+        )
+    for key in ("x0", "r", "target", "sigma", "a"):
+        val = (lqg.get("model", {}) or {}).get(key)
+        if isinstance(val, float) and not math.isfinite(val):
+            problems.append(f"lqg.model.{key}: {val} is not finite")
+    return problems
+
+
+def check_config(
+    config: Mapping[str, Any], schema: Mapping[str, Any] | str | os.PathLike | None = None
+) -> None:
+    """Raise :class:`ConfigError` listing every problem of ``config``; return None if valid.
+
+    ``schema`` is the schema mapping or its path (default: the repository's schema file).
+    """
+    if not isinstance(schema, Mapping):
+        schema = load_schema(schema)
+    validator = Draft202012Validator(schema)
+    errors = sorted(
+        validator.iter_errors(dict(config)), key=lambda e: list(map(str, e.absolute_path))
+    )
+    problems = [_message(e) for e in errors]
+    if not problems:
+        problems = _cross_field(config)
+    if problems:
+        raise ConfigError(
+            "invalid configuration (nothing was run):\n  - " + "\n  - ".join(problems)
+        )

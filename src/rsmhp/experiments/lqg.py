@@ -1,0 +1,240 @@
+"""LQG experiments: estimator convergence in P (paper Fig. 3) and the NBO error over (a, H).
+
+Both drivers return one row per (parameters, replicate). Row ``(P, replicate)`` draws
+its ``P x H`` noise from ``job_rng(seed, <experiment>, a=..., H=..., ..., P=P, replicate=i)``.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from rsmhp import lqg
+from rsmhp.estimators import nbo_estimate, uniform_estimate, weighted_estimate
+from rsmhp.parallel import chunked, parallel_map
+from rsmhp.sampling import sample_independent
+from rsmhp.seeding import job_rng
+
+__all__ = [
+    "CONVERGENCE_COLUMNS",
+    "NBO_ERROR_COLUMNS",
+    "LQGParams",
+    "p_grid",
+    "run_convergence",
+    "run_nbo_error",
+]
+
+log = logging.getLogger(__name__)
+
+CONVERGENCE_COLUMNS = [
+    "a",
+    "H",
+    "sigma",
+    "r",
+    "target",
+    "x0",
+    "u",
+    "P",
+    "replicate",
+    "J_mhp",
+    "J_mhp_weighted",
+    "J_nbo",
+    "J_exact",
+]
+NBO_ERROR_COLUMNS = [
+    "a",
+    "H",
+    "sigma",
+    "r",
+    "target",
+    "x0",
+    "u_value",
+    "P",
+    "replicate",
+    "J_mhp",
+    "J_nbo",
+    "nbo_error_sim",
+    "nbo_error_se",
+    "nbo_error_closed",
+    "J_exact",
+]
+
+
+@dataclass(frozen=True)
+class LQGParams:
+    """Model parameters of the oven LQG (see :mod:`rsmhp.lqg`)."""
+
+    a: float
+    x0: float
+    r: float
+    target: float
+    sigma: float
+
+    @classmethod
+    def from_config(cls, model: Mapping[str, Any], a: float | None = None) -> LQGParams:
+        return cls(
+            a=float(model["a"] if a is None else a),
+            x0=float(model["x0"]),
+            r=float(model["r"]),
+            target=float(model["target"]),
+            sigma=float(model["sigma"]),
+        )
+
+    def model(self) -> lqg.LQGModel:
+        return lqg.LQGModel(a=self.a, r=self.r, target=self.target, sigma=self.sigma)
+
+    def closed(self) -> dict[str, float]:
+        """Keyword arguments of the closed forms in :mod:`rsmhp.lqg`."""
+        return {"x0": self.x0, "a": self.a, "r": self.r, "target": self.target, "sigma": self.sigma}
+
+
+def p_grid(spec: Mapping[str, int]) -> list[int]:
+    """``range(start, stop + 1, step)`` from a ``{start, stop, step}`` mapping (stop inclusive)."""
+    return list(range(int(spec["start"]), int(spec["stop"]) + 1, int(spec["step"])))
+
+
+def _estimate_row(
+    seed: int, experiment: str, params: LQGParams, u: np.ndarray, P: int, replicate: int
+) -> tuple[float, float, float]:
+    """One MHP estimate from P non-overlapping trajectories: (uniform, weighted, std of costs)."""
+    rng = job_rng(
+        seed,
+        experiment,
+        a=params.a,
+        H=len(u),
+        sigma=params.sigma,
+        r=params.r,
+        target=params.target,
+        x0=params.x0,
+        u=u,
+        P=P,
+        replicate=replicate,
+    )
+    traj = sample_independent(params.model(), [params.x0], u, P, rng)
+    return (
+        float(uniform_estimate(traj.cost)),
+        float(weighted_estimate(traj.cost, traj.log_likeliness)),
+        float(np.std(traj.cost, ddof=1)) if P > 1 else float("nan"),
+    )
+
+
+def _convergence_chunk(job: tuple[int, LQGParams, tuple[float, ...], list[int], int]) -> list[dict]:
+    seed, params, u_t, p_values, replicates = job
+    u = np.asarray(u_t)
+    j_nbo = lqg.nbo_cost(u, x0=params.x0, a=params.a, r=params.r, target=params.target)
+    j_exact = lqg.exact_cost(u, **params.closed())
+    u_text = ";".join(repr(float(v)) for v in u)
+    rows = []
+    for P in p_values:
+        for rep in range(replicates):
+            j_u, j_w, _ = _estimate_row(seed, "lqg_convergence", params, u, P, rep)
+            rows.append(
+                {
+                    "a": params.a,
+                    "H": len(u),
+                    "sigma": params.sigma,
+                    "r": params.r,
+                    "target": params.target,
+                    "x0": params.x0,
+                    "u": u_text,
+                    "P": P,
+                    "replicate": rep,
+                    "J_mhp": j_u,
+                    "J_mhp_weighted": j_w,
+                    "J_nbo": j_nbo,
+                    "J_exact": j_exact,
+                }
+            )
+    return rows
+
+
+def run_convergence(cfg: Mapping[str, Any], seed: int, n_jobs: int = 1) -> pd.DataFrame:
+    """Fig. 3 experiment: ``replicates`` MHP estimates (non-overlapping, uniform and weighted)
+    for every P in the grid, next to the NBO and exact costs (closed forms).
+
+    ``cfg`` is the ``lqg`` config section (``model`` and ``convergence``).
+    """
+    params = LQGParams.from_config(cfg["model"])
+    conv = cfg["convergence"]
+    u = tuple(float(v) for v in conv["u"])
+    ps = p_grid(conv["P"])
+    reps = int(conv["replicates"])
+    # large P first so the long chunks start early; chunking never changes the numbers
+    chunks = chunked(sorted(ps, reverse=True), max(1, 4 * n_jobs))
+    jobs = [(seed, params, u, chunk, reps) for chunk in chunks]
+    log.info(
+        "lqg_convergence: %d P values x %d replicates in %d chunks on %d workers",
+        len(ps),
+        reps,
+        len(jobs),
+        n_jobs,
+    )
+    rows = [
+        row
+        for part in parallel_map(_convergence_chunk, jobs, n_jobs, desc="chunks")
+        for row in part
+    ]
+    df = pd.DataFrame(rows, columns=CONVERGENCE_COLUMNS)
+    return df.sort_values(["P", "replicate"], kind="stable").reset_index(drop=True)
+
+
+def _nbo_error_chunk(job: tuple[int, Mapping[str, Any], list[tuple[float, int]]]) -> list[dict]:
+    seed, cfg, grid = job
+    ne = cfg["nbo_error"]
+    P, reps, u_value = int(ne["P"]), int(ne["replicates"]), float(ne["u_value"])
+    rows = []
+    for a, H in grid:
+        params = LQGParams.from_config(cfg["model"], a=a)
+        u = np.full(H, u_value)
+        system = params.model()
+        j_nbo_sim = nbo_estimate(system, [params.x0], u)
+        closed = lqg.nbo_error(H, a=params.a, r=params.r, sigma=params.sigma)
+        j_exact = lqg.exact_cost(u, **params.closed())
+        for rep in range(reps):
+            j_u, _, sd = _estimate_row(seed, "lqg_nbo_error", params, u, P, rep)
+            rows.append(
+                {
+                    "a": params.a,
+                    "H": H,
+                    "sigma": params.sigma,
+                    "r": params.r,
+                    "target": params.target,
+                    "x0": params.x0,
+                    "u_value": u_value,
+                    "P": P,
+                    "replicate": rep,
+                    "J_mhp": j_u,
+                    "J_nbo": j_nbo_sim,
+                    "nbo_error_sim": j_u - j_nbo_sim,
+                    "nbo_error_se": sd / np.sqrt(P),
+                    "nbo_error_closed": closed,
+                    "J_exact": j_exact,
+                }
+            )
+    return rows
+
+
+def run_nbo_error(cfg: Mapping[str, Any], seed: int, n_jobs: int = 1) -> pd.DataFrame:
+    r"""NBO error over the (a, H) grid: simulated :math:`\hat J_P - J_{NBO}` (the NBO cost from
+    the simulated system with zero noise) next to :math:`r\sigma^2\sum_{n<H}(1-a)^{2n}`."""
+    ne = cfg["nbo_error"]
+    grid = [(float(a), int(H)) for a in ne["a_values"] for H in ne["H_values"]]
+    chunks = chunked(grid, max(1, 4 * n_jobs))
+    jobs = [(seed, dict(cfg), chunk) for chunk in chunks]
+    log.info(
+        "lqg_nbo_error: %d (a, H) points x %d replicates, P=%d, %d workers",
+        len(grid),
+        ne["replicates"],
+        ne["P"],
+        n_jobs,
+    )
+    rows = [
+        row for part in parallel_map(_nbo_error_chunk, jobs, n_jobs, desc="chunks") for row in part
+    ]
+    df = pd.DataFrame(rows, columns=NBO_ERROR_COLUMNS)
+    return df.sort_values(["a", "H", "replicate"], kind="stable").reset_index(drop=True)

@@ -1,0 +1,47 @@
+"""Glue for Snakemake rule scripts: logging to the rule's log file, errors recorded there."""
+
+from __future__ import annotations
+
+import logging
+import os
+import sys
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+__all__ = ["rule_logging"]
+
+
+@contextmanager
+def rule_logging(log_path: str | os.PathLike, rule: str) -> Iterator[logging.Logger]:
+    """Send ``logging`` (INFO and up) to ``log_path`` and stderr for the duration of a rule script.
+
+    Any exception is logged with its traceback, then re-raised so Snakemake marks the job
+    failed (and removes its partial outputs; outputs are written atomically anyway).
+    """
+    Path(log_path).parent.mkdir(parents=True, exist_ok=True)
+    handlers = [
+        logging.FileHandler(log_path, mode="w", encoding="utf-8"),
+        logging.StreamHandler(sys.stderr),
+    ]
+    fmt = logging.Formatter("%(asctime)s %(levelname)s %(name)s: %(message)s")
+    root = logging.getLogger()
+    for h in handlers:
+        h.setFormatter(fmt)
+        root.addHandler(h)
+    root.setLevel(logging.INFO)
+    log = logging.getLogger(f"rsmhp.rule.{rule}")
+    start = time.perf_counter()
+    log.info("start")
+    try:
+        yield log
+    except Exception:
+        log.exception("failed")
+        raise
+    else:
+        log.info("done in %.2f s", time.perf_counter() - start)
+    finally:
+        for h in handlers:
+            root.removeHandler(h)
+            h.close()

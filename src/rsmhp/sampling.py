@@ -1,0 +1,261 @@
+r"""Trajectory sampling for RS-MHP: non-overlapping, tree, and pruned tree.
+
+Conventions (used everywhere in this project)
+---------------------------------------------
+A system evolves as :math:`x_{k+1} = f(x_k, u_k, w_k)` for :math:`k = 0, \dots, H-1` with
+i.i.d. Gaussian noise :math:`w_k \sim \mathcal N(0, \Sigma)`. A trajectory therefore has
+``H`` noise draws and ``H + 1`` states :math:`x_0, \dots, x_H`; its cost is
+
+.. math:: g_i = \sum_{k=0}^{H-1} g(x_k^i, u_k) + g_H(x_H^i).
+
+* **Non-overlapping sampling** (paper Fig. 1b): ``P`` independent trajectories, no shared nodes.
+* **Tree sampling** (paper Fig. 1a): at every step ``k`` draw ``N`` noise values
+  :math:`w_k^1..w_k^N` and branch every current node ``N`` ways. With ``shared_draws=True``
+  (the paper's construction, :math:`x_2^{i,j} = f(x_1^i, u_1, w_1^j)`) the same ``N`` values
+  are used by every node of level ``k``; with ``shared_draws=False`` each node draws its own
+  ``N`` children. Without pruning the tree has :math:`N^H` leaves (one branching per noise
+  draw; the paper counts :math:`N^{H-1}` because its stage costs stop at :math:`x_{H-1}`).
+* **Likeliness** of a noise sample is its probability density :math:`\phi_\Sigma(w)`; the
+  likeliness of a trajectory is the product over its steps, stored as the sum of log-densities.
+* **Pruning to M**: after each branching, if more than ``M`` nodes exist, keep the ``M`` with the
+  highest trajectory likeliness (ties broken by lower index) and drop the rest.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Protocol
+
+import numpy as np
+
+__all__ = [
+    "GaussianNoise",
+    "System",
+    "Trajectories",
+    "TreeLevel",
+    "TreeSample",
+    "sample_independent",
+    "sample_tree",
+    "top_m",
+]
+
+
+class GaussianNoise:
+    r"""Zero-mean Gaussian noise :math:`w \sim \mathcal N(0, \Sigma)` of dimension ``d``.
+
+    Parameters
+    ----------
+    cov : (d, d) array_like or scalar variance
+        Covariance :math:`\Sigma` (symmetric positive definite). A scalar means ``d = 1``.
+    """
+
+    def __init__(self, cov: float | np.ndarray) -> None:
+        cov = np.atleast_2d(np.asarray(cov, dtype=float))
+        if cov.shape[0] != cov.shape[1]:
+            raise ValueError(f"noise covariance must be square, got shape {cov.shape}")
+        if not np.allclose(cov, cov.T):
+            raise ValueError("noise covariance must be symmetric")
+        self.cov = cov
+        self.dim = cov.shape[0]
+        self._chol = np.linalg.cholesky(cov)  # raises LinAlgError if not positive definite
+        self._log_norm = -0.5 * (self.dim * np.log(2 * np.pi)) - np.sum(np.log(np.diag(self._chol)))
+
+    @property
+    def mean(self) -> np.ndarray:
+        """The nominal noise value used by NBO, :math:`\\bar w = 0`, shape (d,)."""
+        return np.zeros(self.dim)
+
+    def sample(self, rng: np.random.Generator, size: int | tuple[int, ...]) -> np.ndarray:
+        """Draw noise, shape ``(*size, d)``: :math:`w = L z`, :math:`z \\sim \\mathcal N(0, I)`."""
+        size = (size,) if isinstance(size, (int, np.integer)) else tuple(size)
+        z = rng.standard_normal((*size, self.dim))
+        return z @ self._chol.T
+
+    def logpdf(self, w: np.ndarray) -> np.ndarray:
+        r"""Log density :math:`\log\phi_\Sigma(w)`; ``w`` shape ``(..., d)``, result ``(...)``."""
+        w = np.asarray(w, dtype=float)
+        # solve L y = w  =>  w^T Sigma^{-1} w = |y|^2
+        flat = w.reshape(-1, self.dim)
+        y = np.linalg.solve(self._chol, flat.T).T if self.dim > 1 else flat / self._chol[0, 0]
+        return (self._log_norm - 0.5 * np.sum(y * y, axis=-1)).reshape(w.shape[:-1])
+
+
+class System(Protocol):
+    """A discrete-time stochastic system with additive-or-not Gaussian noise, vectorized.
+
+    ``x`` has shape ``(n, dx)``, ``w`` shape ``(n, dw)``, ``u_k`` the control at step ``k``.
+    """
+
+    noise: GaussianNoise
+
+    def step(self, x: np.ndarray, u_k: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """:math:`x_{k+1} = f(x_k, u_k, w_k)`, shape (n, dx)."""
+        ...
+
+    def stage_cost(self, x: np.ndarray, u_k: np.ndarray) -> np.ndarray:
+        """:math:`g(x_k, u_k)`, shape (n,)."""
+        ...
+
+    def terminal_cost(self, x: np.ndarray) -> np.ndarray:
+        """:math:`g_H(x_H)`, shape (n,)."""
+        ...
+
+
+@dataclass(frozen=True)
+class Trajectories:
+    """A set of sampled trajectories.
+
+    Attributes
+    ----------
+    states : (n, H+1, dx)  states :math:`x_0..x_H` of every trajectory
+    noise : (n, H, dw)     noise draws :math:`w_0..w_{H-1}`
+    log_likeliness : (n,)  :math:`\\sum_k \\log\\phi(w_k)` (log of the trajectory likeliness)
+    cost : (n,)            :math:`g_i`, the cumulative cost of every trajectory
+    """
+
+    states: np.ndarray
+    noise: np.ndarray
+    log_likeliness: np.ndarray
+    cost: np.ndarray
+
+    def __len__(self) -> int:
+        return int(self.cost.shape[0])
+
+
+@dataclass(frozen=True)
+class TreeLevel:
+    """One level ``k+1`` of a sampled tree, *before* pruning.
+
+    Attributes
+    ----------
+    states : (n_children, dx)  :math:`x_{k+1}` of every child
+    parent : (n_children,)     index of the parent among the *kept* nodes of level ``k``
+    log_likeliness : (n_children,)
+    kept : (n_children,) bool  survived pruning at this level
+    """
+
+    states: np.ndarray
+    parent: np.ndarray
+    log_likeliness: np.ndarray
+    kept: np.ndarray
+
+
+@dataclass(frozen=True)
+class TreeSample:
+    """Leaves of a (possibly pruned) tree and, optionally, its level-by-level history."""
+
+    leaves: Trajectories
+    history: list[TreeLevel] = field(default_factory=list)
+
+
+def _controls(u: np.ndarray | list[float]) -> np.ndarray:
+    u = np.asarray(u, dtype=float)
+    if u.ndim == 0 or u.shape[0] == 0:
+        raise ValueError("control sequence u must have at least one step (length H >= 1)")
+    return u
+
+
+def top_m(log_likeliness: np.ndarray, m: int) -> np.ndarray:
+    """Indices of the ``m`` largest entries, sorted by decreasing likeliness, ties by index.
+
+    Returns all indices (in that order) when ``m >= len(log_likeliness)``.
+    """
+    if m < 1:
+        raise ValueError(f"M must be >= 1, got {m}")
+    order = np.argsort(-np.asarray(log_likeliness), kind="stable")
+    return order[:m]
+
+
+def sample_independent(
+    system: System, x0: np.ndarray, u: np.ndarray | list[float], n: int, rng: np.random.Generator
+) -> Trajectories:
+    """Non-overlapping sampling (Fig. 1b): ``n`` independent trajectories from ``x0`` under ``u``.
+
+    Noise is drawn as one ``(n, H, dw)`` block, so the stream is the same whatever ``H``-loop
+    implementation is used.
+    """
+    u = _controls(u)
+    if n < 1:
+        raise ValueError(f"number of trajectories must be >= 1, got {n}")
+    horizon = u.shape[0]
+    w = system.noise.sample(rng, (n, horizon))
+    x = np.broadcast_to(np.atleast_1d(np.asarray(x0, dtype=float)), (n, np.size(x0))).copy()
+    states = np.empty((n, horizon + 1, x.shape[1]))
+    states[:, 0] = x
+    cost = np.zeros(n)
+    for k in range(horizon):
+        cost += system.stage_cost(x, u[k])
+        x = system.step(x, u[k], w[:, k])
+        states[:, k + 1] = x
+    cost += system.terminal_cost(x)
+    loglik = system.noise.logpdf(w).sum(axis=1)
+    return Trajectories(states=states, noise=w, log_likeliness=loglik, cost=cost)
+
+
+def sample_tree(
+    system: System,
+    x0: np.ndarray,
+    u: np.ndarray | list[float],
+    n_branch: int,
+    rng: np.random.Generator,
+    *,
+    max_keep: int | None = None,
+    shared_draws: bool = True,
+    keep_history: bool = False,
+) -> TreeSample:
+    """Tree sampling with ``N = n_branch`` draws per step (Fig. 1a), optionally pruned to ``M``.
+
+    At step ``k`` the kept nodes (``n_k`` of them) branch ``N`` ways; the ``n_k N`` children get
+    likeliness ``parent * phi(w)``; if ``max_keep`` is set and ``n_k N > M`` only the top ``M``
+    children (by likeliness) are kept. Without pruning there are ``N^H`` leaves.
+
+    Parameters
+    ----------
+    shared_draws : the paper's tree (same ``N`` noise values for every node of a level) if True,
+        otherwise every node draws its own ``N`` children.
+    keep_history : record every level before pruning (for recordings/diagnostics).
+    """
+    u = _controls(u)
+    if n_branch < 1:
+        raise ValueError(f"N (draws per step) must be >= 1, got {n_branch}")
+    if max_keep is not None and max_keep < 1:
+        raise ValueError(f"M (trajectories kept) must be >= 1, got {max_keep}")
+    horizon = u.shape[0]
+    if max_keep is None and n_branch**horizon > 20_000_000:
+        raise ValueError(
+            f"an unpruned tree with N={n_branch}, H={horizon} has {n_branch**horizon} leaves; "
+            "set M (pruning) or reduce N/H"
+        )
+    noise = system.noise
+    x = np.atleast_1d(np.asarray(x0, dtype=float))[None, :]
+    paths = x[:, None, :]  # (n, k+1, dx)
+    w_paths = np.empty((1, 0, noise.dim))
+    loglik = np.zeros(1)
+    cost = np.zeros(1)
+    history: list[TreeLevel] = []
+    for k in range(horizon):
+        n_nodes = x.shape[0]
+        if shared_draws:
+            w_new = noise.sample(rng, n_branch)  # (N, dw)
+            w_child = np.tile(w_new, (n_nodes, 1))
+        else:
+            w_child = noise.sample(rng, (n_nodes, n_branch)).reshape(-1, noise.dim)
+        parent = np.repeat(np.arange(n_nodes), n_branch)
+        cost_parent = cost + system.stage_cost(x, u[k])
+        x_child = system.step(x[parent], u[k], w_child)
+        ll_child = loglik[parent] + noise.logpdf(w_child)
+        if max_keep is not None and x_child.shape[0] > max_keep:
+            keep = np.sort(top_m(ll_child, max_keep))  # keep tree order for readability
+        else:
+            keep = np.arange(x_child.shape[0])
+        if keep_history:
+            kept_mask = np.zeros(x_child.shape[0], dtype=bool)
+            kept_mask[keep] = True
+            history.append(TreeLevel(x_child, parent, ll_child, kept_mask))
+        sel = parent[keep]
+        paths = np.concatenate([paths[sel], x_child[keep][:, None, :]], axis=1)
+        w_paths = np.concatenate([w_paths[sel], w_child[keep][:, None, :]], axis=1)
+        x, loglik, cost = x_child[keep], ll_child[keep], cost_parent[sel]
+    cost = cost + system.terminal_cost(x)
+    leaves = Trajectories(states=paths, noise=w_paths, log_likeliness=loglik, cost=cost)
+    return TreeSample(leaves=leaves, history=history)

@@ -1,0 +1,69 @@
+"""Small, exact statistics helpers used by the aggregation rules.
+
+* :func:`mean_ci` - Student-t confidence interval of a mean.
+* :func:`binomial_ci` - Clopper-Pearson (exact) interval of a proportion.
+* :func:`loglog_slope` - OLS slope of log(y) on log(x) with a t-based confidence interval.
+* :func:`rmse_ci` - RMSE with a chi-square interval assuming the errors are N(0, s^2)-like.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import stats
+
+__all__ = ["SlopeFit", "binomial_ci", "loglog_slope", "mean_ci", "rmse_ci"]
+
+
+def mean_ci(x: np.ndarray, level: float = 0.95) -> tuple[float, float, float]:
+    r"""(mean, low, high): :math:`\bar x \pm t_{n-1,(1+level)/2}\, s/\sqrt n`."""
+    x = np.asarray(x, dtype=float)
+    n = x.size
+    if n < 2:
+        raise ValueError("need at least 2 values for a confidence interval")
+    m = float(x.mean())
+    half = float(stats.t.ppf(0.5 + level / 2, n - 1) * x.std(ddof=1) / np.sqrt(n))
+    return m, m - half, m + half
+
+
+def binomial_ci(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
+    """Clopper-Pearson interval for a proportion ``k/n``."""
+    if n < 1 or not 0 <= k <= n:
+        raise ValueError(f"need 0 <= k <= n and n >= 1, got k={k}, n={n}")
+    ci = stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="exact")
+    return float(ci.low), float(ci.high)
+
+
+def rmse_ci(err: np.ndarray, level: float = 0.95) -> tuple[float, float, float]:
+    r"""(rmse, low, high) of errors ``err`` about 0: :math:`n\,\mathrm{MSE}/\sigma^2 \sim \chi^2_n`
+    when the errors are i.i.d. :math:`N(0,\sigma^2)`; exact for unbiased Gaussian errors."""
+    err = np.asarray(err, dtype=float)
+    n = err.size
+    ss = float(np.sum(err**2))
+    lo = np.sqrt(ss / stats.chi2.ppf(0.5 + level / 2, n))
+    hi = np.sqrt(ss / stats.chi2.ppf(0.5 - level / 2, n))
+    return float(np.sqrt(ss / n)), float(lo), float(hi)
+
+
+@dataclass(frozen=True)
+class SlopeFit:
+    slope: float
+    low: float
+    high: float
+    intercept: float
+
+    def contains(self, value: float) -> bool:
+        return self.low <= value <= self.high
+
+
+def loglog_slope(x: np.ndarray, y: np.ndarray, level: float = 0.95) -> SlopeFit:
+    r"""Fit :math:`\log y = c + s \log x` by OLS; CI :math:`s \pm t_{n-2}\,\mathrm{se}(s)`."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    if x.size < 3 or np.any(x <= 0) or np.any(y <= 0):
+        raise ValueError("need >= 3 strictly positive points for a log-log fit")
+    res = stats.linregress(np.log(x), np.log(y))
+    half = float(stats.t.ppf(0.5 + level / 2, x.size - 2) * res.stderr)
+    return SlopeFit(
+        float(res.slope), float(res.slope - half), float(res.slope + half), float(res.intercept)
+    )

@@ -1,0 +1,115 @@
+# Case study 1: scalar LQG (paper Sec. III-A, Fig. 3).
+# Simulation, aggregation, figures, recording are separate rules: changing a figure
+# never reruns a simulation.
+
+LQG_TABLES = ["lqg_convergence", "lqg_nbo_error", "lqg_chebyshev"]
+LQG_FIGURES = ["lqg_convergence", "lqg_error_loglog", "lqg_nbo_error"]
+REPORT_FIGURES.extend(LQG_FIGURES)
+
+
+rule lqg_convergence:
+    output:
+        "results/lqg/convergence.csv",
+    log:
+        "results/logs/lqg_convergence.log",
+    benchmark:
+        "results/benchmarks/lqg_convergence.tsv"
+    threads: THREADS
+    resources:
+        mem_mb=2000,
+        runtime=20,
+    params:
+        lqg={k: config["lqg"][k] for k in ("model", "convergence")},
+        seed=config["seed"],
+    script:
+        "../scripts/lqg_convergence.py"
+
+
+rule lqg_nbo_error:
+    output:
+        "results/lqg/nbo_error.csv",
+    log:
+        "results/logs/lqg_nbo_error.log",
+    benchmark:
+        "results/benchmarks/lqg_nbo_error.tsv"
+    threads: THREADS
+    resources:
+        mem_mb=2000,
+        runtime=20,
+    params:
+        lqg={k: config["lqg"][k] for k in ("model", "nbo_error")},
+        seed=config["seed"],
+    script:
+        "../scripts/lqg_nbo_error.py"
+
+
+rule lqg_summary:
+    input:
+        convergence="results/lqg/convergence.csv",
+        nbo_error="results/lqg/nbo_error.csv",
+    output:
+        summary="results/lqg/summary.csv",
+        nbo_summary="results/lqg/nbo_error_summary.csv",
+        tables=expand("results/tables/{name}.md", name=LQG_TABLES),
+        section="results/report/lqg.json",
+    log:
+        "results/logs/lqg_summary.log",
+    benchmark:
+        "results/benchmarks/lqg_summary.tsv"
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
+    params:
+        eps=config["lqg"]["convergence"]["chebyshev_eps"],
+    script:
+        "../scripts/lqg_summary.py"
+
+
+rule lqg_figures:
+    input:
+        convergence="results/lqg/convergence.csv",
+        summary="results/lqg/summary.csv",
+        nbo_summary="results/lqg/nbo_error_summary.csv",
+    output:
+        expand("results/figures/{name}.{ext}", name=LQG_FIGURES, ext=("png", "pdf")),
+    log:
+        "results/logs/lqg_figures.log",
+    benchmark:
+        "results/benchmarks/lqg_figures.tsv"
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
+    params:
+        eps=config["lqg"]["convergence"]["chebyshev_eps"],
+    script:
+        "../scripts/lqg_figures.py"
+
+
+rule lqg_recording:
+    output:
+        "results/recordings/lqg_tree.rrd",
+    log:
+        "results/logs/lqg_recording.log",
+    benchmark:
+        "results/benchmarks/lqg_recording.tsv"
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        model=config["lqg"]["model"],
+        recording=config["lqg"]["recording"],
+        seed=config["seed"],
+    script:
+        "../scripts/lqg_recording.py"
+
+
+rule lqg:
+    input:
+        rules.lqg_convergence.output,
+        rules.lqg_nbo_error.output,
+        rules.lqg_summary.output,
+        rules.lqg_figures.output,
+        rules.lqg_recording.output,

@@ -1,0 +1,22 @@
+# The replication report: paper/replication.md plus the figures it shows.
+
+
+rule report:
+    input:
+        sections=list(REPORT_SECTIONS.values()),
+        figures=expand("results/figures/{name}.png", name=REPORT_FIGURES),
+    output:
+        report="paper/replication.md",
+        figures=expand("paper/figures/{name}.png", name=REPORT_FIGURES),
+    log:
+        "results/logs/report.log",
+    benchmark:
+        "results/benchmarks/report.tsv"
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    params:
+        config=config,
+    script:
+        "../scripts/report.py"

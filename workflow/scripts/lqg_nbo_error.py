@@ -1,0 +1,9 @@
+"""Rule lqg_nbo_error: simulated vs closed-form NBO error over (a, H)."""
+
+from rsmhp.experiments.lqg import run_nbo_error
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake.log[0], snakemake.rule):
+    df = run_nbo_error(snakemake.params.lqg, snakemake.params.seed, n_jobs=snakemake.threads)
+    write_csv(df, snakemake.output[0])

@@ -1,0 +1,21 @@
+"""Rule lqg_summary: per-P summary, NBO-error summary, Markdown tables, report section."""
+
+from pathlib import Path
+
+from rsmhp.analysis import lqg as analysis
+from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, NBO_ERROR_COLUMNS
+from rsmhp.io import read_table, write_csv, write_text
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake.log[0], snakemake.rule):
+    eps = list(snakemake.params.eps)
+    conv = read_table(snakemake.input.convergence, CONVERGENCE_COLUMNS)
+    nbo = read_table(snakemake.input.nbo_error, NBO_ERROR_COLUMNS)
+    summary = analysis.summarize_convergence(conv, eps)
+    nbo_summary = analysis.summarize_nbo_error(nbo)
+    tables = analysis.lqg_tables(summary, nbo_summary, eps)
+    write_csv(summary, snakemake.output.summary)
+    write_csv(nbo_summary, snakemake.output.nbo_summary)
+    for path in snakemake.output.tables:
+        write_text(tables[Path(path).stem] + "\n", path)
+    analysis.lqg_section(summary, nbo_summary, conv, eps, tables).save(snakemake.output.section)
