@@ -6,6 +6,17 @@ from rsmhp.config import check_config
 
 min_version("9.0")
 
+# Jobs import rsmhp from this repository's src/, also under --use-conda where the editable
+# install of the project's virtual environment is not visible. This prepends to PYTHONPATH;
+# the workflow requires no environment variable from the user.
+os.environ.update(
+    PYTHONPATH=os.pathsep.join(
+        filter(
+            None, [os.path.join(workflow.basedir, "src"), os.environ.get("PYTHONPATH")]
+        )
+    )
+)
+
 
 configfile: os.path.join(workflow.basedir, "config", "config.yaml")
 

@@ -42,7 +42,7 @@ def _plain(value: Any) -> Any:
     raise TypeError(f"job identifier values must be numbers, strings or sequences, got {value!r}")
 
 
-def canonical_job_id(experiment: str, **params: Any) -> str:
+def canonical_job_id(experiment: str, /, **params: Any) -> str:
     """Canonical text of a job identifier: JSON with sorted keys, floats in shortest repr.
 
     ``canonical_job_id("lqg", a=0.5, P=100)`` == ``'{"P":100,"a":0.5,"experiment":"lqg"}'``.
@@ -56,7 +56,7 @@ def canonical_job_id(experiment: str, **params: Any) -> str:
     return json.dumps(payload, sort_keys=True, separators=(",", ":"), allow_nan=False)
 
 
-def job_seed_sequence(root_seed: int, experiment: str, **params: Any) -> np.random.SeedSequence:
+def job_seed_sequence(root_seed: int, experiment: str, /, **params: Any) -> np.random.SeedSequence:
     """SeedSequence for one job: entropy ``root_seed``, spawn key = BLAKE2b-128 of the job id.
 
     The spawn key is the digest split into four little-endian uint32 words.
@@ -70,6 +70,6 @@ def job_seed_sequence(root_seed: int, experiment: str, **params: Any) -> np.rand
     return np.random.SeedSequence(entropy=int(root_seed), spawn_key=words)
 
 
-def job_rng(root_seed: int, experiment: str, **params: Any) -> np.random.Generator:
+def job_rng(root_seed: int, experiment: str, /, **params: Any) -> np.random.Generator:
     """A PCG64 :class:`numpy.random.Generator` seeded by :func:`job_seed_sequence`."""
     return np.random.Generator(np.random.PCG64(job_seed_sequence(root_seed, experiment, **params)))

@@ -14,12 +14,18 @@ rule lqg_convergence:
         "results/logs/lqg_convergence.log",
     benchmark:
         "results/benchmarks/lqg_convergence.tsv"
+    conda:
+        ENV
     threads: THREADS
     resources:
         mem_mb=2000,
         runtime=20,
     params:
-        lqg={k: config["lqg"][k] for k in ("model", "convergence")},
+        # only what the simulation depends on: changing chebyshev_eps reruns no simulation
+        lqg={
+            "model": pick(config["lqg"]["model"], "a", "x0", "r", "target", "sigma"),
+            "convergence": pick(config["lqg"]["convergence"], "u", "P", "replicates"),
+        },
         seed=config["seed"],
     script:
         "../scripts/lqg_convergence.py"
@@ -32,12 +38,14 @@ rule lqg_nbo_error:
         "results/logs/lqg_nbo_error.log",
     benchmark:
         "results/benchmarks/lqg_nbo_error.tsv"
+    conda:
+        ENV
     threads: THREADS
     resources:
         mem_mb=2000,
         runtime=20,
     params:
-        lqg={k: config["lqg"][k] for k in ("model", "nbo_error")},
+        lqg=pick(config["lqg"], "model", "nbo_error"),
         seed=config["seed"],
     script:
         "../scripts/lqg_nbo_error.py"
@@ -56,6 +64,8 @@ rule lqg_summary:
         "results/logs/lqg_summary.log",
     benchmark:
         "results/benchmarks/lqg_summary.tsv"
+    conda:
+        ENV
     threads: 1
     resources:
         mem_mb=2000,
@@ -77,6 +87,8 @@ rule lqg_figures:
         "results/logs/lqg_figures.log",
     benchmark:
         "results/benchmarks/lqg_figures.tsv"
+    conda:
+        ENV
     threads: 1
     resources:
         mem_mb=2000,
@@ -94,13 +106,15 @@ rule lqg_recording:
         "results/logs/lqg_recording.log",
     benchmark:
         "results/benchmarks/lqg_recording.tsv"
+    conda:
+        ENV
     threads: 1
     resources:
         mem_mb=1000,
         runtime=5,
     params:
-        model=config["lqg"]["model"],
-        recording=config["lqg"]["recording"],
+        model=canonical(config["lqg"]["model"]),
+        recording=canonical(config["lqg"]["recording"]),
         seed=config["seed"],
     script:
         "../scripts/lqg_recording.py"

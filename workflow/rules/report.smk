@@ -12,11 +12,13 @@ rule report:
         "results/logs/report.log",
     benchmark:
         "results/benchmarks/report.tsv"
+    conda:
+        ENV
     threads: 1
     resources:
         mem_mb=500,
         runtime=5,
     params:
-        config=config,
+        config=canonical(config),
     script:
         "../scripts/report.py"

@@ -1,0 +1,62 @@
+"""Config validation: the default config passes; bad values name the field and range."""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import pytest
+import yaml
+
+from rsmhp.config import ConfigError, check_config
+
+ROOT = Path(__file__).resolve().parents[1]
+DEFAULT = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+
+
+def test_default_and_test_configs_are_valid():
+    check_config(DEFAULT)
+    tiny = yaml.safe_load((ROOT / "tests" / "config" / "tiny.yaml").read_text())
+    merged = copy.deepcopy(DEFAULT)
+    merged.update({k: v for k, v in tiny.items() if k != "lqg"})
+    for k, v in tiny["lqg"].items():
+        merged["lqg"][k] = {**merged["lqg"][k], **v}
+    check_config(merged)
+
+
+def _with(path: str, value):
+    cfg = copy.deepcopy(DEFAULT)
+    *parents, leaf = path.split(".")
+    node = cfg
+    for p in parents:
+        node = node[p]
+    node[leaf] = value
+    return cfg
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "expected"),
+    [
+        ("lqg.model.sigma", -1.0, r"lqg\.model\.sigma: -1\.0 .*allowed: number in \(0, 1000\]"),
+        ("lqg.model.a", 1.5, r"lqg\.model\.a: 1\.5 .*allowed: number in \(0, 1\)"),
+        ("lqg.model.a", 0, r"lqg\.model\.a: 0 .*allowed: number in \(0, 1\)"),
+        ("lqg.recording.M", 9, r"lqg\.recording\.M: 9 is greater than lqg\.recording\.N = 4"),
+        ("lqg.convergence.replicates", 1, r"lqg\.convergence\.replicates: 1 .*\[3, 100000\]"),
+        ("lqg.convergence.P", {"start": 500, "stop": 100, "step": 1}, r"P\.start: 500"),
+        ("lqg.nbo_error.H_values", [1, 0], r"lqg\.nbo_error\.H_values\[1\]: 0"),
+        ("seed", "abc", r"seed: 'abc' is invalid"),
+        ("lqg.bogus", 1, r"lqg\.bogus: unknown key"),
+        ("typo_top", 1, r"typo_top: unknown key"),
+    ],
+)
+def test_bad_values_are_named(path, value, expected):
+    with pytest.raises(ConfigError, match=expected):
+        check_config(_with(path, value))
+
+
+def test_all_problems_reported_at_once():
+    cfg = _with("lqg.model.sigma", -1.0)
+    cfg["lqg"]["model"]["a"] = 2.0
+    with pytest.raises(ConfigError) as exc:
+        check_config(cfg)
+    assert "lqg.model.sigma" in str(exc.value) and "lqg.model.a" in str(exc.value)

@@ -1,0 +1,155 @@
+"""End-to-end runs of the Snakemake workflow on tests/config/tiny.yaml in temporary directories."""
+
+from __future__ import annotations
+
+import hashlib
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+from rerun.chunk import RrdReader
+
+from rsmhp import lqg
+
+ROOT = Path(__file__).resolve().parents[1]
+TINY = ROOT / "tests" / "config" / "tiny.yaml"
+pytestmark = pytest.mark.workflow
+
+CSVS = [
+    "results/lqg/convergence.csv",
+    "results/lqg/nbo_error.csv",
+    "results/lqg/summary.csv",
+    "results/lqg/nbo_error_summary.csv",
+]
+
+
+def snakemake(workdir: Path, *args: str, configfile: Path = TINY) -> subprocess.CompletedProcess:
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir),
+           "--configfile", str(configfile), *args]  # fmt: skip
+    return subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+
+
+def digest(workdir: Path) -> dict[str, str]:
+    files = [p for p in sorted((workdir / "results").rglob("*")) if p.is_file()]
+    files += [p for p in sorted((workdir / "paper").rglob("*")) if p.is_file()]
+    return {str(p.relative_to(workdir)): hashlib.sha256(p.read_bytes()).hexdigest() for p in files}
+
+
+@pytest.fixture(scope="module")
+def run_j2(tmp_path_factory) -> Path:
+    wd = tmp_path_factory.mktemp("wf_j2")
+    res = snakemake(wd, "-j2")
+    assert res.returncode == 0, res.stderr[-3000:]
+    return wd
+
+
+@pytest.fixture(scope="module")
+def tiny() -> dict:
+    return yaml.safe_load(TINY.read_text())
+
+
+def test_outputs_content(run_j2, tiny):
+    conv = pd.read_csv(run_j2 / "results/lqg/convergence.csv")
+    grid = tiny["lqg"]["convergence"]["P"]
+    ps = list(range(grid["start"], grid["stop"] + 1, grid["step"]))
+    reps = tiny["lqg"]["convergence"]["replicates"]
+    assert len(conv) == len(ps) * reps
+    for col in ("a", "H", "sigma", "r", "target", "x0", "P", "replicate", "J_mhp", "J_nbo",
+                "J_exact"):  # fmt: skip
+        assert col in conv.columns
+    u = [0.55, 0.17]  # default u (not overridden by the tiny config)
+    kw = {"x0": 0.0, "a": 0.5, "r": 10.0, "target": 1.0, "sigma": 1.0}
+    assert np.allclose(conv["J_exact"], lqg.exact_cost(u, **kw))
+    summary = pd.read_csv(run_j2 / "results/lqg/summary.csv")
+    assert summary["P"].tolist() == ps
+    assert (summary["n_replicates"] == reps).all()
+    for P, grp in conv.groupby("P"):
+        row = summary[summary["P"] == P].iloc[0]
+        assert row["mean"] == pytest.approx(grp["J_mhp"].mean())
+        assert row["rmse"] == pytest.approx(np.sqrt(np.mean((grp["J_mhp"] - grp["J_exact"]) ** 2)))
+        for eps in tiny["lqg"]["convergence"]["chebyshev_eps"]:
+            freq = np.mean(np.abs(grp["J_mhp"] - grp["J_exact"]) >= eps)
+            assert row[f"exceed_eps{eps:g}"] == pytest.approx(freq)
+    nbo = pd.read_csv(run_j2 / "results/lqg/nbo_error_summary.csv")
+    assert len(nbo) == 4
+    for _, row in nbo.iterrows():
+        assert row["nbo_error_closed"] == pytest.approx(
+            lqg.nbo_error(int(row["H"]), a=row["a"], r=10.0, sigma=1.0)
+        )
+    for name in ("lqg_convergence", "lqg_nbo_error", "lqg_chebyshev"):
+        text = (run_j2 / f"results/tables/{name}.md").read_text()
+        assert text.startswith("|") and text.count("\n") >= 3
+    for name in ("lqg_convergence", "lqg_error_loglog", "lqg_nbo_error"):
+        png = (run_j2 / f"results/figures/{name}.png").read_bytes()
+        assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+        assert (run_j2 / f"results/figures/{name}.pdf").read_bytes()[:5] == b"%PDF-"
+        assert (run_j2 / f"paper/figures/{name}.png").read_bytes() == png
+    for rule in ("lqg_convergence", "lqg_nbo_error", "lqg_summary", "lqg_figures", "report"):
+        assert (run_j2 / f"results/benchmarks/{rule}.tsv").exists()
+        assert "done in" in (run_j2 / f"results/logs/{rule}.log").read_text()
+
+
+def test_recording_and_report(run_j2, tiny):
+    rec = tiny["lqg"]["recording"]
+    counts: dict[str, int] = {}
+    for chunk in RrdReader(run_j2 / "results/recordings/lqg_tree.rrd").store().stream():
+        counts[chunk.entity_path] = counts.get(chunk.entity_path, 0) + chunk.num_rows
+    for k in range(1, len(rec["u"]) + 1):
+        assert f"/tree/level_{k}/kept" in counts
+    report = (run_j2 / "paper/replication.md").read_text()
+    for cid in ("LQG-1", "LQG-2", "LQG-3", "LQG-4"):
+        assert f"| {cid} |" in report
+    summary = pd.read_csv(run_j2 / "results/lqg/summary.csv")
+    assert f"J = {summary['J_exact'].iloc[0]:.4f}" in report
+    assert "seed: 7" in report  # the tiny config's seed, i.e. the parameters actually used
+    for link in ("figures/lqg_convergence.png", "figures/lqg_error_loglog.png"):
+        assert f"]({link})" in report and (run_j2 / "paper" / link).exists()
+
+
+def test_j1_and_j2_are_byte_identical(run_j2, tmp_path):
+    res = snakemake(tmp_path, "-j1", "lqg")
+    assert res.returncode == 0, res.stderr[-3000:]
+    for rel in CSVS:
+        assert (tmp_path / rel).read_bytes() == (run_j2 / rel).read_bytes(), rel
+    assert not (tmp_path / "paper").exists()  # the `lqg` target does not build the report
+
+
+def test_up_to_date_and_figure_change_reruns_no_simulation(run_j2, tmp_path, tiny):
+    res = snakemake(run_j2, "-j1", "-n")
+    assert res.returncode == 0 and "Nothing to be done" in res.stdout + res.stderr
+    changed = yaml.safe_load(TINY.read_text())
+    changed["lqg"]["convergence"]["chebyshev_eps"] = [0.5, 3.0]
+    cfg = tmp_path / "eps.yaml"
+    cfg.write_text(yaml.safe_dump(changed))
+    res = snakemake(run_j2, "-j1", "-n", configfile=cfg)
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out
+    assert "lqg_summary" in out and "lqg_figures" in out
+    assert "rule lqg_convergence" not in out and "rule lqg_nbo_error" not in out
+
+
+@pytest.mark.parametrize(
+    ("override", "field"),
+    [
+        ({"lqg": {"model": {"sigma": -1.0}}}, "lqg.model.sigma"),
+        ({"lqg": {"model": {"a": 1.3}}}, "lqg.model.a"),
+        ({"lqg": {"model": {"bogus_key": 1}}}, "lqg.model.bogus_key"),
+        ({"lqg": {"recording": {"N": 2, "M": 5}}}, "lqg.recording.M"),
+    ],
+)
+def test_invalid_config_fails_before_any_job(run_j2, tmp_path, override, field):
+    before = digest(run_j2)
+    cfg = tmp_path / "bad.yaml"
+    cfg.write_text(yaml.safe_dump(override))
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(run_j2),
+           "--configfile", str(TINY), str(cfg), "-j2", "--forceall"]  # fmt: skip
+    res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    out = res.stdout + res.stderr
+    assert res.returncode != 0
+    assert field in out and "invalid configuration" in out
+    assert "Select jobs to execute" not in out and "rule lqg_" not in out
+    assert digest(run_j2) == before
