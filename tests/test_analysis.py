@@ -25,10 +25,23 @@ def synthetic(errors_by_p: dict[int, np.ndarray], weighted_offset: float = 0.0) 
     rows = []
     for P, err in errors_by_p.items():
         for i, e in enumerate(err):
-            rows.append({"a": 0.5, "H": 2, "sigma": 1.0, "r": 10.0, "target": 1.0, "x0": 0.0,
-                         "u": "0.55;0.17", "P": P, "replicate": i, "J_mhp": J + e,
-                         "J_mhp_weighted": J + weighted_offset + e, "J_nbo": J_NBO,
-                         "J_exact": J})  # fmt: skip
+            rows.append(
+                {
+                    "a": 0.5,
+                    "H": 2,
+                    "sigma": 1.0,
+                    "r": 10.0,
+                    "target": 1.0,
+                    "x0": 0.0,
+                    "u": "0.55;0.17",
+                    "P": P,
+                    "replicate": i,
+                    "J_mhp": J + e,
+                    "J_mhp_weighted": J + weighted_offset + e,
+                    "J_nbo": J_NBO,
+                    "J_exact": J,
+                }
+            )
     return pd.DataFrame(rows, columns=CONVERGENCE_COLUMNS)
 
 
@@ -40,9 +53,7 @@ def test_summary_values_from_known_errors():
     assert first["rmse"] == pytest.approx(np.sqrt(np.mean(err**2)))
     assert first["exceed_eps1"] == pytest.approx(3 / 4)  # |e| >= 1: -1, 2, -3
     assert first["exceed_eps2.5"] == pytest.approx(1 / 4)
-    assert first["bound_eps1"] == pytest.approx(
-        min(1.0, lqg.cost_variance(PAPER_U, **PAPER) / 100)
-    )
+    assert first["bound_eps1"] == pytest.approx(min(1.0, lqg.cost_variance(PAPER_U, **PAPER) / 100))
     assert first["sd_theory"] == pytest.approx(np.sqrt(lqg.mhp_variance(100, PAPER_U, **PAPER)))
     assert s["P"].tolist() == [100, 400]
 
@@ -89,8 +100,13 @@ def test_section_roundtrip_and_report(tmp_path):
     section.save(tmp_path / "lqg.json")
     loaded = Section.load(tmp_path / "lqg.json")
     assert loaded == section
-    other = Section(key="zzz", title="Later study", order=5, body="text",
-                    claims=[Claim("X-1", "c", "s", "e", "m", "inconclusive")])  # fmt: skip
+    other = Section(
+        key="zzz",
+        title="Later study",
+        order=5,
+        body="text",
+        claims=[Claim("X-1", "c", "s", "e", "m", "inconclusive")],
+    )
     text = render_report([loaded, other], {"seed": 2}, {"numpy": "x"})
     assert text.index("## Later study") < text.index("## Case study 1")
     for c in [*section.claims, *other.claims]:

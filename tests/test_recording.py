@@ -40,5 +40,7 @@ def test_recording_is_deterministic(tmp_path, paper_params):
     a = record_lqg_tree(tmp_path / "a.rrd", paper_params, u, 3, 2, seed=5)
     b = record_lqg_tree(tmp_path / "b.rrd", paper_params, u, 3, 2, seed=5)
     assert a == b
-    ids = {r.recording_id for p in ("a", "b") for r in RrdReader(tmp_path / f"{p}.rrd").recordings()}
+    ids = {
+        r.recording_id for p in ("a", "b") for r in RrdReader(tmp_path / f"{p}.rrd").recordings()
+    }
     assert len(ids) == 1

@@ -36,9 +36,14 @@ def test_same_job_same_stream_different_job_different_stream():
 BASE = {
     "model": {"a": 0.5, "x0": 0.0, "r": 10.0, "target": 1.0, "sigma": 1.0},
     "convergence": {"u": [0.55, 0.17], "P": {"start": 20, "stop": 60, "step": 20}, "replicates": 4},
-    "nbo_error": {"a_values": [0.3, 0.6], "H_values": [1, 3], "P": 50, "replicates": 3,
-                  "u_value": 0.3},
-}  # fmt: skip
+    "nbo_error": {
+        "a_values": [0.3, 0.6],
+        "H_values": [1, 3],
+        "P": 50,
+        "replicates": 3,
+        "u_value": 0.3,
+    },
+}
 
 
 def test_results_independent_of_worker_count():
@@ -52,8 +57,14 @@ def test_results_independent_of_worker_count():
 
 def test_adding_p_values_or_replicates_keeps_existing_rows():
     base = run_convergence(BASE, seed=3)
-    more = {**BASE, "convergence": {**BASE["convergence"], "replicates": 6,
-                                    "P": {"start": 10, "stop": 80, "step": 10}}}  # fmt: skip
+    more = {
+        **BASE,
+        "convergence": {
+            **BASE["convergence"],
+            "replicates": 6,
+            "P": {"start": 10, "stop": 80, "step": 10},
+        },
+    }
     bigger = run_convergence(more, seed=3)
     key = ["P", "replicate"]
     merged = base.merge(bigger, on=key, suffixes=("", "_new"))

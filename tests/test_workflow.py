@@ -28,8 +28,18 @@ CSVS = [
 
 
 def snakemake(workdir: Path, *args: str, configfile: Path = TINY) -> subprocess.CompletedProcess:
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir),
-           "--configfile", str(configfile), *args]  # fmt: skip
+    cmd = [
+        sys.executable,
+        "-m",
+        "snakemake",
+        "-s",
+        str(ROOT / "Snakefile"),
+        "-d",
+        str(workdir),
+        "--configfile",
+        str(configfile),
+        *args,
+    ]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=600)
 
 
@@ -58,8 +68,19 @@ def test_outputs_content(run_j2, tiny):
     ps = list(range(grid["start"], grid["stop"] + 1, grid["step"]))
     reps = tiny["lqg"]["convergence"]["replicates"]
     assert len(conv) == len(ps) * reps
-    for col in ("a", "H", "sigma", "r", "target", "x0", "P", "replicate", "J_mhp", "J_nbo",
-                "J_exact"):  # fmt: skip
+    for col in (
+        "a",
+        "H",
+        "sigma",
+        "r",
+        "target",
+        "x0",
+        "P",
+        "replicate",
+        "J_mhp",
+        "J_nbo",
+        "J_exact",
+    ):
         assert col in conv.columns
     u = [0.55, 0.17]  # default u (not overridden by the tiny config)
     kw = {"x0": 0.0, "a": 0.5, "r": 10.0, "target": 1.0, "sigma": 1.0}
@@ -145,8 +166,20 @@ def test_invalid_config_fails_before_any_job(run_j2, tmp_path, override, field):
     before = digest(run_j2)
     cfg = tmp_path / "bad.yaml"
     cfg.write_text(yaml.safe_dump(override))
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(run_j2),
-           "--configfile", str(TINY), str(cfg), "-j2", "--forceall"]  # fmt: skip
+    cmd = [
+        sys.executable,
+        "-m",
+        "snakemake",
+        "-s",
+        str(ROOT / "Snakefile"),
+        "-d",
+        str(run_j2),
+        "--configfile",
+        str(TINY),
+        str(cfg),
+        "-j2",
+        "--forceall",
+    ]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
     out = res.stdout + res.stderr
     assert res.returncode != 0
