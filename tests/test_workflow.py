@@ -27,7 +27,9 @@ CSVS = [
 ]
 
 
-def snakemake(workdir: Path, *args: str, configfile: Path = TINY) -> subprocess.CompletedProcess:
+def snakemake(
+    workdir: Path, *args: str, configfiles: tuple[Path, ...] = (TINY,)
+) -> subprocess.CompletedProcess:
     cmd = [
         sys.executable,
         "-m",
@@ -37,7 +39,7 @@ def snakemake(workdir: Path, *args: str, configfile: Path = TINY) -> subprocess.
         "-d",
         str(workdir),
         "--configfile",
-        str(configfile),
+        *map(str, configfiles),
         *args,
     ]
     return subprocess.run(cmd, capture_output=True, text=True, timeout=600)
@@ -146,7 +148,7 @@ def test_up_to_date_and_figure_change_reruns_no_simulation(run_j2, tmp_path, tin
     changed["lqg"]["convergence"]["chebyshev_eps"] = [0.5, 3.0]
     cfg = tmp_path / "eps.yaml"
     cfg.write_text(yaml.safe_dump(changed))
-    res = snakemake(run_j2, "-j1", "-n", configfile=cfg)
+    res = snakemake(run_j2, "-j1", "-n", configfiles=(cfg,))
     out = res.stdout + res.stderr
     assert res.returncode == 0, out
     assert "lqg_summary" in out and "lqg_figures" in out
@@ -166,21 +168,7 @@ def test_invalid_config_fails_before_any_job(run_j2, tmp_path, override, field):
     before = digest(run_j2)
     cfg = tmp_path / "bad.yaml"
     cfg.write_text(yaml.safe_dump(override))
-    cmd = [
-        sys.executable,
-        "-m",
-        "snakemake",
-        "-s",
-        str(ROOT / "Snakefile"),
-        "-d",
-        str(run_j2),
-        "--configfile",
-        str(TINY),
-        str(cfg),
-        "-j2",
-        "--forceall",
-    ]
-    res = subprocess.run(cmd, capture_output=True, text=True, timeout=600)
+    res = snakemake(run_j2, "-j2", "--forceall", configfiles=(TINY, cfg))
     out = res.stdout + res.stderr
     assert res.returncode != 0
     assert field in out and "invalid configuration" in out
