@@ -166,30 +166,47 @@ def top_m(log_likeliness: np.ndarray, m: int) -> np.ndarray:
     return order[:m]
 
 
-def sample_independent(
-    system: System, x0: np.ndarray, u: np.ndarray | list[float], n: int, rng: np.random.Generator
+def rollout(
+    system: System, x0: np.ndarray, u: np.ndarray | list[float], noise: np.ndarray
 ) -> Trajectories:
-    """Non-overlapping sampling (Fig. 1b): ``n`` independent trajectories from ``x0`` under ``u``.
+    """Propagate given noise sequences: ``noise`` has shape ``(n, H, dw)`` with ``H = len(u)``.
 
-    Noise is drawn as one ``(n, H, dw)`` block, so the stream is the same whatever ``H``-loop
-    implementation is used.
+    Every sampler (plain Monte Carlo, antithetic, quasi-Monte Carlo, quadrature nodes) produces
+    noise sequences and calls this; the trajectory costs it returns are then averaged.
     """
     u = _controls(u)
-    if n < 1:
-        raise ValueError(f"number of trajectories must be >= 1, got {n}")
+    noise = np.asarray(noise, dtype=float)
     horizon = u.shape[0]
-    w = system.noise.sample(rng, (n, horizon))
-    x = np.broadcast_to(np.atleast_1d(np.asarray(x0, dtype=float)), (n, np.size(x0))).copy()
+    if noise.ndim != 3 or noise.shape[1] != horizon or noise.shape[2] != system.noise.dim:
+        raise ValueError(
+            f"noise must have shape (n, H={horizon}, dw={system.noise.dim}), got {noise.shape}"
+        )
+    n = noise.shape[0]
+    x0 = np.atleast_1d(np.asarray(x0, dtype=float))
+    x = np.broadcast_to(x0, (n, x0.size)).copy()
     states = np.empty((n, horizon + 1, x.shape[1]))
     states[:, 0] = x
     cost = np.zeros(n)
     for k in range(horizon):
         cost += system.stage_cost(x, u[k])
-        x = system.step(x, u[k], w[:, k])
+        x = system.step(x, u[k], noise[:, k])
         states[:, k + 1] = x
     cost += system.terminal_cost(x)
-    loglik = system.noise.logpdf(w).sum(axis=1)
-    return Trajectories(states=states, noise=w, log_likeliness=loglik, cost=cost)
+    loglik = system.noise.logpdf(noise).sum(axis=1)
+    return Trajectories(states=states, noise=noise, log_likeliness=loglik, cost=cost)
+
+
+def sample_independent(
+    system: System, x0: np.ndarray, u: np.ndarray | list[float], n: int, rng: np.random.Generator
+) -> Trajectories:
+    """Non-overlapping sampling (Fig. 1b): ``n`` independent trajectories from ``x0`` under ``u``.
+
+    Noise is drawn as one ``(n, H, dw)`` block from ``rng`` and propagated by :func:`rollout`.
+    """
+    u = _controls(u)
+    if n < 1:
+        raise ValueError(f"number of trajectories must be >= 1, got {n}")
+    return rollout(system, x0, u, system.noise.sample(rng, (n, u.shape[0])))
 
 
 def sample_tree(
