@@ -18,9 +18,11 @@ def test_default_and_test_configs_are_valid():
     check_config(DEFAULT)
     tiny = yaml.safe_load((ROOT / "tests" / "config" / "tiny.yaml").read_text())
     merged = copy.deepcopy(DEFAULT)
-    merged.update({k: v for k, v in tiny.items() if k != "lqg"})
-    for k, v in tiny["lqg"].items():
-        merged["lqg"][k] = {**merged["lqg"][k], **v}
+    for section in ("lqg", "estimators"):
+        for k, v in tiny[section].items():
+            old = merged[section].get(k)
+            merged[section][k] = {**old, **v} if isinstance(old, dict) else v
+    merged["seed"], merged["threads"] = tiny["seed"], tiny["threads"]
     check_config(merged)
 
 
@@ -47,6 +49,20 @@ def _with(path: str, value):
         ("seed", "abc", r"seed: 'abc' is invalid"),
         ("lqg.bogus", 1, r"lqg\.bogus: unknown key"),
         ("typo_top", 1, r"typo_top: unknown key"),
+        ("estimators.budgets", [16, 48], r"estimators\.budgets: 48 is not a power of 2"),
+        ("estimators.recording", {"N": 2, "M": 3, "u": [0.1]}, r"estimators\.recording\.M: 3"),
+        ("estimators.max_leaves", 2, r"estimators\.max_leaves: 2 .*\[4, 1000000\]"),
+        ("estimators.schemes", ["mc", "magic"], r"estimators\.schemes\[1\]: 'magic'"),
+        (
+            "estimators.problems",
+            [{"name": "p", "kind": "ncv_2d", "u": [[0.1, 0.2]], "dt": 1.0}],
+            r"estimators\.problems\[0\] \(p\): kind ncv_2d needs \['q', ",
+        ),
+        (
+            "estimators.problems",
+            [{"name": "p", "kind": "scalar_lqg", "u": [0.1]}] * 2,
+            r"duplicate name\(s\) \['p'\]",
+        ),
     ],
 )
 def test_bad_values_are_named(path, value, expected):

@@ -133,12 +133,62 @@ def test_recording_and_report(run_j2, tiny):
         assert f"]({link})" in report and (run_j2 / "paper" / link).exists()
 
 
-def test_j1_and_j2_are_byte_identical(run_j2, tmp_path):
-    res = snakemake(tmp_path, "-j1", "lqg")
+def test_j1_and_j2_give_identical_results(run_j2, tmp_path):
+    res = snakemake(tmp_path, "-j1", "lqg", "estimators")
     assert res.returncode == 0, res.stderr[-3000:]
     for rel in CSVS:
         assert (tmp_path / rel).read_bytes() == (run_j2 / rel).read_bytes(), rel
-    assert not (tmp_path / "paper").exists()  # the `lqg` target does not build the report
+    # the ablation's CPU times are measurements; every other column is identical
+    for rel, timing in (
+        ("results/estimators/ablation.csv", "cpu_seconds"),
+        ("results/estimators/summary.csv", "cpu_median"),
+    ):
+        a = pd.read_csv(tmp_path / rel).drop(columns=timing)
+        b = pd.read_csv(run_j2 / rel).drop(columns=timing)
+        assert a.to_csv(index=False) == b.to_csv(index=False), rel
+    assert not (tmp_path / "paper").exists()  # named targets do not build the report
+
+
+def test_estimator_study_outputs(run_j2, tiny):
+    est = tiny["estimators"]
+    ablation = pd.read_csv(run_j2 / "results/estimators/ablation.csv")
+    summary = pd.read_csv(run_j2 / "results/estimators/summary.csv")
+    assert set(ablation["problem"]) == {p["name"] for p in est["problems"]}
+    mc = ablation[(ablation["scheme"] == "mc") & (ablation["weighting"] == "uniform")]
+    assert len(mc) == len(est["problems"]) * len(est["budgets"]) * est["replicates"]
+    trees = ablation[ablation["scheme"] == "tree"]
+    assert (trees["n_trajectories"] <= est["max_leaves"]).all()
+    for _, row in summary.iterrows():
+        raw = ablation[
+            (ablation["problem"] == row["problem"])
+            & (ablation["scheme"] == row["scheme"])
+            & (ablation["weighting"] == row["weighting"])
+            & (ablation["N"] == row["N"])
+            & (ablation["M"] == row["M"])
+            & (ablation["n_trajectories"] == row["n_trajectories"])
+        ]
+        assert len(raw) == row["n_replicates"]
+        assert row["mean"] == pytest.approx(raw["estimate"].mean())
+    for name in (
+        "est_rmse_vs_n",
+        "est_tree_variance",
+        "est_weighted_vs_uniform",
+        "est_pruning_heatmap",
+        "est_frontier",
+    ):
+        assert (run_j2 / f"results/figures/{name}.png").read_bytes()[:4] == b"\x89PNG"
+        assert (run_j2 / f"paper/figures/{name}.png").exists()
+    report = (run_j2 / "paper/replication.md").read_text()
+    for cid in ("EST-1", "EST-2", "EST-3", "EST-4"):
+        assert f"| {cid} |" in report
+    # sections in report order: LQG (10) before the estimator study (15)
+    assert report.index("## Case study 1") < report.index("## Estimator study")
+    rec = est["recording"]
+    counts: dict[str, int] = {}
+    for chunk in RrdReader(run_j2 / "results/recordings/estimators_tree.rrd").store().stream():
+        counts[chunk.entity_path] = counts.get(chunk.entity_path, 0) + chunk.num_rows
+    assert counts["/pruning"] == len(rec["u"])
+    assert all(f"/tree/level_{k}/nodes" in counts for k in range(1, len(rec["u"]) + 1))
 
 
 def test_up_to_date_and_figure_change_reruns_no_simulation(run_j2, tmp_path, tiny):
@@ -162,6 +212,8 @@ def test_up_to_date_and_figure_change_reruns_no_simulation(run_j2, tmp_path, tin
         ({"lqg": {"model": {"a": 1.3}}}, "lqg.model.a"),
         ({"lqg": {"model": {"bogus_key": 1}}}, "lqg.model.bogus_key"),
         ({"lqg": {"recording": {"N": 2, "M": 5}}}, "lqg.recording.M"),
+        ({"estimators": {"recording": {"N": 2, "M": 3}}}, "estimators.recording.M"),
+        ({"estimators": {"budgets": [16, 48]}}, "estimators.budgets"),
     ],
 )
 def test_invalid_config_fails_before_any_job(run_j2, tmp_path, override, field):

@@ -92,11 +92,70 @@ def _cross_field(config: Mapping[str, Any]) -> list[str]:
             f"lqg.recording.M: {rec['M']} is greater than lqg.recording.N = {rec['N']} "
             f"(allowed: 1 <= M <= N; the paper prunes to M <= N trajectories)"
         )
+    est = config.get("estimators", {}) or {}
+    problems.extend(_estimator_problems(est.get("problems", []) or []))
+    for n in est.get("budgets", []) or []:
+        if isinstance(n, int) and n & (n - 1):
+            problems.append(
+                f"estimators.budgets: {n} is not a power of 2 (allowed: 2, 4, 8, ... for Sobol')"
+            )
+    pr = est.get("pruning", {}) or {}
+    if pr.get("N") and pr.get("M") and min(pr["M"]) > max(pr["N"]):
+        problems.append(
+            f"estimators.pruning.M: every M ({min(pr['M'])} and up) is greater than every N "
+            f"(at most {max(pr['N'])}) (allowed: M <= N for at least one pair)"
+        )
+    erec = est.get("recording", {}) or {}
+    if {"N", "M"} <= erec.keys() and erec["M"] > erec["N"]:
+        problems.append(
+            f"estimators.recording.M: {erec['M']} is greater than estimators.recording.N = "
+            f"{erec['N']} (allowed: 1 <= M <= N)"
+        )
     for key in ("x0", "r", "target", "sigma", "a"):
         val = (lqg.get("model", {}) or {}).get(key)
         if isinstance(val, float) and not math.isfinite(val):
             problems.append(f"lqg.model.{key}: {val} is not finite")
     return problems
+
+
+NCV_KEYS = ("dt", "q", "w_pos", "w_vel", "r_u", "f_pos", "f_vel", "target", "x0")
+
+
+def _estimator_problems(problems: list[Mapping[str, Any]]) -> list[str]:
+    """Unique names and per-kind requirements of ``estimators.problems`` entries."""
+    out = []
+    names = [spec.get("name") for spec in problems]
+    dupes = sorted({n for n in names if names.count(n) > 1})
+    if dupes:
+        out.append(f"estimators.problems: duplicate name(s) {dupes} (allowed: unique names)")
+    for i, spec in enumerate(problems):
+        path = f"estimators.problems[{i}] ({spec.get('name')})"
+        u = spec.get("u", [])
+        if spec.get("kind") == "scalar_lqg":
+            if any(isinstance(v, list) for v in u):
+                out.append(f"{path}.u: {u} must be a list of numbers for kind scalar_lqg")
+            for key in ("x0", "target"):
+                if isinstance(spec.get(key), list):
+                    out.append(f"{path}.{key}: must be a number for kind scalar_lqg")
+            extra = sorted(set(spec) & (set(NCV_KEYS) - {"x0", "target"}))
+            if extra:
+                out.append(f"{path}: {extra} only apply to kind ncv_2d")
+        elif spec.get("kind") == "ncv_2d":
+            missing = [k for k in NCV_KEYS if k not in spec]
+            if missing:
+                out.append(f"{path}: kind ncv_2d needs {missing}")
+            for key in ("target", "x0"):
+                val = spec.get(key)
+                if key in spec and (not isinstance(val, list) or len(val) != 4):
+                    out.append(
+                        f"{path}.{key}: {val!r} must be a list of 4 numbers (px, py, vx, vy)"
+                    )
+            if not all(isinstance(v, list) for v in u):
+                out.append(f"{path}.u: {u} must be a list of [ax, ay] pairs for kind ncv_2d")
+            extra = sorted(set(spec) & {"a", "sigma", "r"})
+            if extra:
+                out.append(f"{path}: {extra} only apply to kind scalar_lqg")
+    return out
 
 
 def check_config(

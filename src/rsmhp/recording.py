@@ -5,8 +5,9 @@ Layout of a tree recording (timeline ``step``, one tick per tree level):
 * ``tree/level_<k>/kept``    LineStrips2D: edges (k-1, x_parent) -> (k, x_child) that survived
   pruning (green); every level is its own entity so earlier levels stay visible
 * ``tree/level_<k>/pruned``  LineStrips2D: edges dropped by pruning (thin, grey-red)
-* ``tree/level_<k>/nodes``   Points2D: children, radius proportional to their normalized
-  likeliness within the level, colour kept/pruned
+* ``tree/level_<k>/nodes``   Points2D: children; radius and colour (viridis, bright = likely)
+  encode the trajectory likeliness within the level; pruned nodes are drawn red
+* ``pruning``                TextLog: per level, children, kept, and the likeliness cut-off
 * ``estimate/uniform``, ``estimate/weighted``  Scalars: running estimate of J after level k
 * ``estimate/exact``, ``estimate/nbo``  Scalars: the closed-form references
 * ``description``  TextDocument (static): parameters and how to read the view
@@ -46,8 +47,9 @@ def tree_blueprint() -> rrb.Blueprint:
             rrb.Spatial2DView(origin="/tree", name="sampled tree: state x_k vs step k"),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="/estimate", name="running estimate of J"),
+                rrb.TextLogView(origin="/pruning", name="pruning log"),
                 rrb.TextDocumentView(origin="/description", name="about"),
-                row_shares=[3, 1],
+                row_shares=[3, 1, 1],
             ),
             column_shares=[3, 2],
         ),
@@ -72,12 +74,13 @@ def record_lqg_tree(
     n_branch: int,
     max_keep: int | None,
     seed: int,
+    experiment: str = "lqg_recording",
 ) -> dict[str, int]:
     """Sample one LQG tree (N = ``n_branch`` per step, pruned to ``max_keep``) and record it.
 
     Returns entity path -> number of logged rows (for checks). The tree's random stream is
-    ``job_rng(seed, "lqg_recording", ...)``; the recording id is derived from the same job id,
-    so a rerun writes the same data.
+    ``job_rng(seed, experiment, ...)``; the recording id is derived from the same job id, so a
+    rerun writes the same data.
     """
     u = np.asarray(u, dtype=float)
     horizon = len(u)
@@ -91,11 +94,11 @@ def record_lqg_tree(
         "N": n_branch,
         "M": max_keep,
     }
-    rng = job_rng(seed, "lqg_recording", **job)
+    rng = job_rng(seed, experiment, **job)
     tree = sample_tree(
         params.model(), [params.x0], u, n_branch, rng, max_keep=max_keep, keep_history=True
     )
-    rec_id = uuid.uuid5(uuid.NAMESPACE_URL, canonical_job_id("lqg_recording", seed=seed, **job))
+    rec_id = uuid.uuid5(uuid.NAMESPACE_URL, canonical_job_id(experiment, seed=seed, **job))
     rec = rr.RecordingStream("rsmhp_lqg_tree", recording_id=str(rec_id))
     rec.set_log_time_enabled(False)  # only the deterministic `step` timeline
     Path(path).parent.mkdir(parents=True, exist_ok=True)
@@ -114,7 +117,8 @@ def record_lqg_tree(
         f"x0={params.x0:g}, u={np.array2string(u, precision=3)}\n\n"
         f"N={n_branch} draws per step (shared by all nodes of a level), H={horizon}, "
         f"pruned to M={max_keep} most likely trajectories.\n\n"
-        "Green: kept branches; red: pruned. Node radius: likeliness within its level. "
+        "Green: kept branches; red: pruned. Node radius and colour (viridis, bright = likely): "
+        "trajectory likeliness within its level; the `pruning` log states each cut. "
         "Scrub the `step` timeline to grow the tree."
     )
     log("description", rr.TextDocument(text, media_type="text/markdown"), static=True)
@@ -147,7 +151,22 @@ def record_lqg_tree(
             )
         q = likeliness_weights(level.log_likeliness)  # mean 1 within the level
         radii = 0.03 + 0.05 * q / q.max()
-        colors = np.where(kept[:, None], np.array(KEPT), np.array(PRUNED[:3]))
+        shade = (q / q.max())[:, None]
+        viridis = np.array([[68, 1, 84], [33, 145, 140], [253, 231, 37]], dtype=float)
+        likely = np.where(
+            shade < 0.5,
+            viridis[0] + 2 * shade * (viridis[1] - viridis[0]),
+            viridis[1] + (2 * shade - 1) * (viridis[2] - viridis[1]),
+        )
+        colors = np.where(kept[:, None], likely, np.array(PRUNED[:3])).astype(np.uint8)
+        cut = level.log_likeliness[kept].min()
+        log(
+            "pruning",
+            rr.TextLog(
+                f"level {k}: {kept.size} children, kept {int(kept.sum())}, dropped "
+                f"{int((~kept).sum())}; kept log-likeliness >= {cut:.3f}"
+            ),
+        )
         points = np.column_stack([np.full_like(x_child, k), x_child])
         log(f"tree/level_{k}/nodes", rr.Points2D(points, radii=radii, colors=colors))
         kept_x = x_child[kept]

@@ -1,0 +1,285 @@
+r"""Estimator ablation: every scheme x weighting x (N, M, budget) on problems with exact J.
+
+Schemes (one row per replicate; ``N``/``M`` are 0 where they do not apply):
+
+============== ============================================== ===================== =========
+scheme         sample                                          n_trajectories        weighting
+============== ============================================== ===================== =========
+``mc``         n independent trajectories (paper Fig. 1b)      n                     uniform,
+                                                                                     weighted
+``antithetic`` n/2 draws and their negatives                   n                     uniform
+``sobol``      scrambled Sobol' (randomized QMC)               n                     uniform
+``tree``       shared-draw tree, N per level (paper Fig. 1a)   N^H                   uniform,
+                                                                                     weighted
+``tree_pernode`` every node draws its own N children           N^H                   uniform,
+                                                                                     weighted
+``pruned``     shared-draw tree pruned to the M most likely    M                     uniform,
+                                                                                     weighted
+``cubature``   2D sigma points (deterministic)                 2D                    quadrature
+``gauss_hermite`` q^D tensor rule, q = N (deterministic)       q^D                   quadrature
+``nbo``        nominal trajectory (deterministic)              1                     nominal
+============== ============================================== ===================== =========
+
+Uniform and weighted rows of a replicate are computed from the *same* sample (paired).
+``cpu_seconds`` is the process CPU time of drawing the sample and forming the estimate; it is the
+only column that is not reproducible bit for bit. Deterministic schemes have one replicate.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from rsmhp import samplers
+from rsmhp.estimators import uniform_estimate, weighted_estimate
+from rsmhp.linear_quadratic import LinearQuadratic
+from rsmhp.parallel import parallel_map
+from rsmhp.sampling import rollout, sample_tree
+from rsmhp.seeding import job_rng
+
+__all__ = ["ABLATION_COLUMNS", "GridPoint", "build_problem", "grid_points", "run_ablation"]
+
+log = logging.getLogger(__name__)
+
+ABLATION_COLUMNS = [
+    "problem",
+    "scheme",
+    "weighting",
+    "N",
+    "M",
+    "H",
+    "n_trajectories",
+    "n_nodes",
+    "replicate",
+    "estimate",
+    "J_exact",
+    "J_nbo",
+    "cpu_seconds",
+]
+
+WEIGHTED_SCHEMES = ("mc", "tree", "tree_pernode", "pruned")
+
+
+def build_problem(spec: Mapping[str, Any], lqg_model: Mapping[str, Any]) -> LinearQuadratic:
+    """A test problem from its config entry.
+
+    ``kind: scalar_lqg``: the oven model (``lqg.model``, overridable per problem) with control
+    sequence ``u``. ``kind: ncv_2d``: a 2-D near-constant-velocity point mass, state (px, py, vx,
+    vy), input acceleration (ax, ay), :math:`A = [[I, dt I], [0, I]]`, :math:`B = [[dt^2/2 I],
+    [dt I]]`, :math:`\\Sigma = q [[dt^3/3 I, dt^2/2 I], [dt^2/2 I, dt I]]`, stage cost
+    :math:`x^\\top \\mathrm{diag}(w_p, w_p, w_v, w_v) x + r_u |u|^2`, terminal cost
+    :math:`(x-t)^\\top \\mathrm{diag}(f_p, f_p, f_v, f_v)(x-t)`.
+    """
+    kind = spec["kind"]
+    if kind == "scalar_lqg":
+        m = {**lqg_model, **{k: spec[k] for k in ("a", "x0", "r", "target", "sigma") if k in spec}}
+        return LinearQuadratic.scalar_lqg(
+            spec["u"], x0=m["x0"], a=m["a"], r=m["r"], target=m["target"], sigma=m["sigma"]
+        )
+    if kind == "ncv_2d":
+        dt, q = float(spec["dt"]), float(spec["q"])
+        eye, zero = np.eye(2), np.zeros((2, 2))
+        return LinearQuadratic(
+            A=np.block([[eye, dt * eye], [zero, eye]]),
+            B=np.vstack([0.5 * dt**2 * eye, dt * eye]),
+            Sigma=q * np.block([[dt**3 / 3 * eye, dt**2 / 2 * eye], [dt**2 / 2 * eye, dt * eye]]),
+            Q=np.diag([spec["w_pos"]] * 2 + [spec["w_vel"]] * 2),
+            R=spec["r_u"] * eye,
+            Qf=np.diag([spec["f_pos"]] * 2 + [spec["f_vel"]] * 2),
+            target=spec["target"],
+            x0=spec["x0"],
+            u=np.asarray(spec["u"], dtype=float),
+        )
+    raise ValueError(f"unknown problem kind {kind!r} (allowed: scalar_lqg, ncv_2d)")
+
+
+@dataclass(frozen=True)
+class GridPoint:
+    """One ablation cell: a problem, a scheme and its size parameters."""
+
+    problem: str
+    scheme: str
+    N: int = 0
+    M: int = 0
+    n: int = 0  # budget for mc / antithetic / sobol
+
+    @property
+    def deterministic(self) -> bool:
+        return self.scheme in ("cubature", "gauss_hermite", "nbo")
+
+
+def grid_points(cfg: Mapping[str, Any], problems: Mapping[str, LinearQuadratic]) -> list[GridPoint]:
+    """Every (problem, scheme, N, M, n) cell of the configured grid (``estimators`` section)."""
+    pts: list[GridPoint] = []
+    schemes = cfg["schemes"]
+    for name, prob in problems.items():
+        D = prob.H * prob.d
+        for scheme in schemes:
+            if scheme in ("mc", "antithetic", "sobol"):
+                pts += [GridPoint(name, scheme, n=n) for n in cfg["budgets"]]
+            elif scheme in ("tree", "tree_pernode"):
+                pts += [
+                    GridPoint(name, scheme, N=N)
+                    for N in cfg["tree_N"]
+                    if N**prob.H <= cfg["max_leaves"]
+                ]
+            elif scheme == "pruned":
+                pts += [
+                    GridPoint(name, scheme, N=N, M=M)
+                    for N in cfg["pruning"]["N"]
+                    for M in cfg["pruning"]["M"]
+                    if M <= N
+                ]
+            elif scheme == "gauss_hermite":
+                qs = sorted({samplers.gauss_hermite_order(n, D) for n in cfg["budgets"]} - {0})
+                pts += [GridPoint(name, scheme, N=q) for q in qs]
+            elif scheme in ("cubature", "nbo"):
+                pts.append(GridPoint(name, scheme))
+            else:
+                raise ValueError(f"unknown scheme {scheme!r}")
+    return pts
+
+
+def _sample(point: GridPoint, prob: LinearQuadratic, rng: np.random.Generator | None):
+    """Returns (cost, log_likeliness or None, quadrature weights or None, n_nodes)."""
+    chol = np.linalg.cholesky(prob.Sigma)
+    H = prob.H
+    s = point.scheme
+    if s == "mc":
+        traj = rollout(prob, prob.x0, prob.u, samplers.monte_carlo(rng, point.n, H, chol)[0])
+        return traj.cost, traj.log_likeliness, None, point.n * H
+    if s in ("antithetic", "sobol"):
+        w, wt = getattr(samplers, s)(rng, point.n, H, chol)
+        return rollout(prob, prob.x0, prob.u, w).cost, None, wt, point.n * H
+    if s in ("tree", "tree_pernode", "pruned"):
+        tree = sample_tree(
+            prob,
+            prob.x0,
+            prob.u,
+            point.N,
+            rng,
+            max_keep=point.M if s == "pruned" else None,
+            shared_draws=s != "tree_pernode",
+        )
+        if s == "pruned":
+            nodes, n_keep = 0, 1
+            for _ in range(H):
+                nodes += n_keep * point.N
+                n_keep = min(point.M, n_keep * point.N)
+        else:
+            nodes = sum(point.N**k for k in range(1, H + 1))
+        return tree.leaves.cost, tree.leaves.log_likeliness, None, nodes
+    if s == "cubature":
+        w, wt = samplers.cubature(H, chol)
+        return rollout(prob, prob.x0, prob.u, w).cost, None, wt, len(wt) * H
+    if s == "gauss_hermite":
+        w, wt = samplers.gauss_hermite(point.N, H, chol)
+        return rollout(prob, prob.x0, prob.u, w).cost, None, wt, len(wt) * H
+    if s == "nbo":
+        traj = rollout(prob, prob.x0, prob.u, np.zeros((1, H, prob.d)))
+        return traj.cost, None, np.ones(1), H
+    raise ValueError(f"unknown scheme {s!r}")
+
+
+def _rows(point: GridPoint, prob: LinearQuadratic, spec: Mapping, seed: int, reps: int) -> Iterator:
+    j_exact, j_nbo = prob.exact_cost(), prob.nbo_cost()
+    for rep in range(1 if point.deterministic else reps):
+        rng = None
+        if not point.deterministic:
+            rng = job_rng(
+                seed,
+                "estimators",
+                problem=point.problem,
+                spec=spec,
+                scheme=point.scheme,
+                N=point.N,
+                M=point.M,
+                n=point.n,
+                replicate=rep,
+            )
+        t0 = time.process_time()
+        cost, loglik, wts, nodes = _sample(point, prob, rng)
+        if wts is not None:
+            estimates = {
+                "quadrature"
+                if point.scheme in samplers.DETERMINISTIC
+                else "nominal"
+                if point.scheme == "nbo"
+                else "uniform": float(wts @ cost)
+            }
+        else:
+            estimates = {"uniform": float(uniform_estimate(cost))}
+            if point.scheme in WEIGHTED_SCHEMES:
+                estimates["weighted"] = float(weighted_estimate(cost, loglik))
+        cpu = time.process_time() - t0
+        for weighting, est in estimates.items():
+            yield {
+                "problem": point.problem,
+                "scheme": point.scheme,
+                "weighting": weighting,
+                "N": point.N,
+                "M": point.M,
+                "H": prob.H,
+                "n_trajectories": len(cost),
+                "n_nodes": nodes,
+                "replicate": rep,
+                "estimate": est,
+                "J_exact": j_exact,
+                "J_nbo": j_nbo,
+                "cpu_seconds": cpu,
+            }
+
+
+def _task(job) -> list[dict]:
+    points, problem_specs, lqg_model, seed, reps = job
+    out = []
+    for point in points:
+        spec = problem_specs[point.problem]
+        prob = build_problem(spec, lqg_model)
+        out.extend(_rows(point, prob, spec, seed, reps))
+    return out
+
+
+def run_ablation(
+    cfg: Mapping[str, Any], lqg_model: Mapping[str, Any], seed: int, n_jobs: int = 1
+) -> pd.DataFrame:
+    """Run the whole grid of the ``estimators`` config section; one row per estimate."""
+    specs = {
+        spec["name"]: {k: v for k, v in spec.items() if k != "name"} for spec in cfg["problems"]
+    }
+    problems = {name: build_problem(spec, lqg_model) for name, spec in specs.items()}
+    points = grid_points(cfg, problems)
+    reps = int(cfg["replicates"])
+    # expensive cells first, then round-robin into 4*n_jobs tasks (results never depend on it)
+    weight = {
+        p: (
+            max(p.n, p.N ** problems[p.problem].H if p.M == 0 else p.N * p.M, 1)
+            * problems[p.problem].H
+        )
+        for p in points
+    }
+    ordered = sorted(points, key=lambda p: -weight[p])
+    n_tasks = max(1, min(len(points), 4 * n_jobs))
+    jobs = [(ordered[i::n_tasks], specs, dict(lqg_model), seed, reps) for i in range(n_tasks)]
+    log.info(
+        "estimators: %d problems, %d grid points, %d replicates, %d tasks on %d workers",
+        len(problems),
+        len(points),
+        reps,
+        len(jobs),
+        n_jobs,
+    )
+    rows = [r for part in parallel_map(_task, jobs, n_jobs, desc="ablation tasks") for r in part]
+    df = pd.DataFrame(rows, columns=ABLATION_COLUMNS)
+    order = {name: i for i, name in enumerate(specs)}
+    df = df.assign(_p=df["problem"].map(order))
+    df = df.sort_values(
+        ["_p", "scheme", "weighting", "N", "M", "n_trajectories", "replicate"], kind="stable"
+    )
+    return df.drop(columns="_p").reset_index(drop=True)

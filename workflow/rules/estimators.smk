@@ -1,0 +1,130 @@
+# Estimator study (beyond the paper): tree vs independent sampling, pruning, weighting,
+# variance-reduction samplers, on problems with an exact J. Simulation, aggregation,
+# figures and recording are separate rules.
+
+EST_TABLES = [
+    "est_largest",
+    "est_tree_vs_independent",
+    "est_pruning",
+    "est_equal_cpu",
+    "est_chebyshev",
+]
+EST_FIGURES = [
+    "est_rmse_vs_n",
+    "est_tree_variance",
+    "est_weighted_vs_uniform",
+    "est_pruning_heatmap",
+    "est_frontier",
+]
+REPORT_SECTIONS["estimators"] = "results/report/estimators.json"
+REPORT_FIGURES.extend(EST_FIGURES)
+
+# what the simulation depends on (analysis-only keys such as chebyshev_k are left out)
+EST_SIM = pick(
+    config["estimators"],
+    "replicates",
+    "problems",
+    "schemes",
+    "budgets",
+    "tree_N",
+    "max_leaves",
+    "pruning",
+)
+
+
+rule estimators_ablation:
+    output:
+        "results/estimators/ablation.csv",
+    log:
+        "results/logs/estimators_ablation.log",
+    benchmark:
+        "results/benchmarks/estimators_ablation.tsv"
+    conda:
+        ENV
+    threads: THREADS
+    resources:
+        mem_mb=3000,
+        runtime=30,
+    params:
+        estimators=EST_SIM,
+        model=canonical(config["lqg"]["model"]),
+        seed=config["seed"],
+    script:
+        "../scripts/estimators_ablation.py"
+
+
+rule estimators_summary:
+    input:
+        ablation="results/estimators/ablation.csv",
+    output:
+        summary="results/estimators/summary.csv",
+        tables=expand("results/tables/{name}.md", name=EST_TABLES),
+        section="results/report/estimators.json",
+    log:
+        "results/logs/estimators_summary.log",
+    benchmark:
+        "results/benchmarks/estimators_summary.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=3000,
+        runtime=10,
+    params:
+        problems=canonical(config["estimators"]["problems"]),
+        model=canonical(config["lqg"]["model"]),
+        ks=config["estimators"]["chebyshev_k"],
+        seed=config["seed"],
+    script:
+        "../scripts/estimators_summary.py"
+
+
+rule estimators_figures:
+    input:
+        summary="results/estimators/summary.csv",
+    output:
+        expand("results/figures/{name}.{ext}", name=EST_FIGURES, ext=("png", "pdf")),
+    log:
+        "results/logs/estimators_figures.log",
+    benchmark:
+        "results/benchmarks/estimators_figures.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        problems=canonical(config["estimators"]["problems"]),
+        model=canonical(config["lqg"]["model"]),
+    script:
+        "../scripts/estimators_figures.py"
+
+
+rule estimators_recording:
+    output:
+        "results/recordings/estimators_tree.rrd",
+    log:
+        "results/logs/estimators_recording.log",
+    benchmark:
+        "results/benchmarks/estimators_recording.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        model=canonical(config["lqg"]["model"]),
+        recording=canonical(config["estimators"]["recording"]),
+        seed=config["seed"],
+    script:
+        "../scripts/estimators_recording.py"
+
+
+rule estimators:
+    input:
+        rules.estimators_ablation.output,
+        rules.estimators_summary.output,
+        rules.estimators_figures.output,
+        rules.estimators_recording.output,

@@ -1,0 +1,14 @@
+"""Rule estimators_ablation: every scheme x weighting x size, seeded per cell and replicate."""
+
+from rsmhp.experiments.estimators import run_ablation
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake.log[0], snakemake.rule):
+    df = run_ablation(
+        snakemake.params.estimators,
+        snakemake.params.model,
+        snakemake.params.seed,
+        n_jobs=snakemake.threads,
+    )
+    write_csv(df, snakemake.output[0])

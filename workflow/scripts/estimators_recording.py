@@ -1,0 +1,18 @@
+"""Rule estimators_recording: step through likeliness pruning of one tree for a chosen (N, M, H)."""
+
+from rsmhp.experiments.lqg import LQGParams
+from rsmhp.pipeline import rule_logging
+from rsmhp.recording import record_lqg_tree
+
+with rule_logging(snakemake.log[0], snakemake.rule) as log:
+    rec = snakemake.params.recording
+    rows = record_lqg_tree(
+        snakemake.output[0],
+        LQGParams.from_config(snakemake.params.model),
+        rec["u"],
+        n_branch=rec["N"],
+        max_keep=rec["M"],
+        seed=snakemake.params.seed,
+        experiment="estimators_recording",
+    )
+    log.info("logged %d entities, %d rows", len(rows), sum(rows.values()))
