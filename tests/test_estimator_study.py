@@ -189,3 +189,10 @@ def test_equal_cpu_gain_uses_the_pareto_frontier():
     # within 2e-4 s sobol reaches 0.1 (n=256), not the 1.0 of its slow n=16 point
     assert g.loc["sobol", "rmse"] == 0.1 and g.loc["sobol", "gain_vs_mc"] == pytest.approx(20.0)
     assert g.loc["mc", "gain_vs_mc"] == 1.0
+
+
+def test_bias_fraction_interval_is_ordered(ablation, problems):
+    s = analysis.summarize_ablation(ablation, problems, seed=11)
+    sampled = s[s["n_replicates"] > 1]
+    assert (sampled["bias_fraction_low"] <= sampled["bias_fraction_of_nbo"]).all()
+    assert (sampled["bias_fraction_of_nbo"] <= sampled["bias_fraction_high"]).all()

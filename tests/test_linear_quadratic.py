@@ -208,3 +208,27 @@ def test_invalid_problems_rejected():
         )
     with pytest.raises(ValueError, match="a must lie"):
         LinearQuadratic.scalar_lqg([0.1], x0=0, a=1.0, r=1, target=0, sigma=1)
+
+
+@pytest.mark.parametrize("weighted", [False, True])
+def test_pruned_tree_tends_to_the_nbo_cost(weighted, rng):
+    """With N -> inf and M fixed, every kept trajectory uses, at each level, one of the M most
+    likely (smallest |w|) draws of that level. If the M-th smallest |w| of N draws is below t,
+    |estimate - c| <= ||b||_1 t + lambda_max(K) H t^2. For N = 20000, M = 2, t = 0.005:
+    P(fewer than 2 of 20000 draws within |w| < t) = P(Bin(20000, 0.004) < 2) < 1e-30."""
+    prob = LinearQuadratic.scalar_lqg(PAPER_U, **PAPER)
+    qf = prob.quadratic_form
+    N, M, t = 20_000, 2, 0.005
+    leaves = sample_tree(prob, prob.x0, prob.u, N, rng, max_keep=M).leaves
+    assert np.abs(leaves.noise).max() < t
+    est = (
+        float(
+            np.sum(np.exp(leaves.log_likeliness - leaves.log_likeliness.max()) * leaves.cost)
+            / np.sum(np.exp(leaves.log_likeliness - leaves.log_likeliness.max()))
+        )
+        if weighted
+        else float(leaves.cost.mean())
+    )
+    bound = np.abs(qf.b).sum() * t + np.linalg.eigvalsh(qf.K).max() * prob.H * t**2
+    assert abs(est - qf.nominal()) <= bound
+    assert bound < 0.01 * (qf.mean() - qf.nominal())  # i.e. the estimate carries the NBO error

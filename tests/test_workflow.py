@@ -171,6 +171,7 @@ def test_estimator_study_outputs(run_j2, tiny):
         assert row["mean"] == pytest.approx(raw["estimate"].mean())
     for name in (
         "est_rmse_vs_n",
+        "est_bias_vs_n",
         "est_tree_variance",
         "est_weighted_vs_uniform",
         "est_pruning_heatmap",

@@ -11,6 +11,7 @@ EST_TABLES = [
 ]
 EST_FIGURES = [
     "est_rmse_vs_n",
+    "est_bias_vs_n",
     "est_tree_variance",
     "est_weighted_vs_uniform",
     "est_pruning_heatmap",

@@ -13,6 +13,7 @@ from rsmhp.figures import theme
 from rsmhp.linear_quadratic import LinearQuadratic
 
 __all__ = [
+    "bias_figure",
     "frontier_figure",
     "pruning_heatmap",
     "rmse_figure",
@@ -46,6 +47,24 @@ def _facets(n: int, ncols: int = 3, size: tuple[float, float] = (4.2, 3.4)):
 
 def rmse_figure(s: pd.DataFrame) -> plt.Figure:
     """RMSE (bootstrap 95% CI as bars) vs number of trajectories, per problem and scheme."""
+    title = "RMSE of every estimator against the number of trajectories (pruned: largest N)"
+    return _metric_figure(s, "rmse", "RMSE", log_y=True, title=title)
+
+
+def bias_figure(s: pd.DataFrame) -> plt.Figure:
+    """Bias (bootstrap 95% CI) relative to the NBO error, vs number of trajectories: 0 is
+    unbiased, 1 means the estimator returns the NBO cost."""
+    scaled = s.assign(
+        rel_bias=s["bias_fraction_of_nbo"],
+        rel_bias_low=s["bias_fraction_low"],
+        rel_bias_high=s["bias_fraction_high"],
+    )
+    title = "Bias of every estimator, in units of the NBO error (pruned: largest N)"
+    return _metric_figure(scaled, "rel_bias", "bias / (J_NBO - J)", log_y=False, title=title)
+
+
+def _metric_figure(s: pd.DataFrame, col: str, ylabel: str, log_y: bool, title: str) -> plt.Figure:
+    """One panel per problem: ``col`` with its ``col_low``/``col_high`` CI against n."""
     theme()
     data = _main_schemes(s)
     problems = list(dict.fromkeys(data["problem"]))
@@ -58,8 +77,8 @@ def rmse_figure(s: pd.DataFrame) -> plt.Figure:
             g = g.sort_values("n_trajectories")
             ax.errorbar(
                 g["n_trajectories"],
-                g["rmse"],
-                yerr=[g["rmse"] - g["rmse_low"], g["rmse_high"] - g["rmse"]],
+                g[col],
+                yerr=[g[col] - g[f"{col}_low"], g[f"{col}_high"] - g[col]],
                 marker="o",
                 ms=3,
                 lw=1.2,
@@ -67,10 +86,14 @@ def rmse_figure(s: pd.DataFrame) -> plt.Figure:
                 color=palette[label],
                 label=label,
             )
-        ax.set(xscale="log", yscale="log", title=problem, xlabel="trajectories n", ylabel="RMSE")
+        ax.set(xscale="log", title=problem, xlabel="trajectories n", ylabel=ylabel)
+        if log_y:
+            ax.set_yscale("log")
+        else:
+            ax.axhline(0.0, color="k", lw=0.8)
     handles, names = axes[0].get_legend_handles_labels()
     fig.legend(handles, names, loc="lower right", fontsize=8, ncols=2)
-    fig.suptitle("RMSE of every estimator against the number of trajectories (pruned: largest N)")
+    fig.suptitle(title)
     fig.tight_layout()
     return fig
 
