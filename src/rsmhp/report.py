@@ -17,9 +17,18 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
+import pandas as pd
 import yaml
 
-__all__ = ["VERDICTS", "Claim", "Section", "claims_table", "provenance", "render_report"]
+__all__ = [
+    "VERDICTS",
+    "Claim",
+    "Section",
+    "claims_table",
+    "markdown_table",
+    "provenance",
+    "render_report",
+]
 
 VERDICTS = ("supported", "not supported", "inconclusive")
 
@@ -69,6 +78,12 @@ class Section:
 
 def _escape(text: str) -> str:
     return text.replace("|", "\\|").replace("\n", " ")
+
+
+def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g") -> str:
+    """Markdown table without index; integer columns in full, floats with ``floatfmt``."""
+    fmts = ["d" if pd.api.types.is_integer_dtype(t) else floatfmt for t in df.dtypes]
+    return df.to_markdown(index=False, floatfmt=fmts)
 
 
 def claims_table(claims: Iterable[Claim]) -> str:

@@ -37,6 +37,7 @@ import pandas as pd
 from rsmhp.experiments.estimators import ABLATION_COLUMNS, build_problem
 from rsmhp.linear_quadratic import LinearQuadratic
 from rsmhp.report import Claim, Section
+from rsmhp.report import markdown_table as _md
 from rsmhp.seeding import job_rng
 from rsmhp.stats import binomial_ci, loglog_slope
 
@@ -402,11 +403,6 @@ def claims(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> tuple[list
         else ("supported" if all_zero else "inconclusive"),
     )
     return [c1, c2, c3, c4], facts
-
-
-def _md(df: pd.DataFrame, floatfmt: str = ".4g") -> str:
-    fmts = ["d" if pd.api.types.is_integer_dtype(t) else floatfmt for t in df.dtypes]
-    return df.to_markdown(index=False, floatfmt=fmts)
 
 
 def tables(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> dict[str, str]:

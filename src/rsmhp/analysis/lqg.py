@@ -30,6 +30,7 @@ from scipy import stats as sps
 from rsmhp import lqg
 from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, NBO_ERROR_COLUMNS
 from rsmhp.report import Claim, Section
+from rsmhp.report import markdown_table as _md
 from rsmhp.stats import binomial_ci, loglog_slope, mean_ci, rmse_ci
 
 __all__ = [
@@ -261,12 +262,6 @@ def convergence_claims(summary: pd.DataFrame, eps_values: Sequence[float]) -> li
         verdict="supported" if w_contains else "not supported",
     )
     return [c2, c3, c4]
-
-
-def _md(df: pd.DataFrame, floatfmt: str = ".4g") -> str:
-    """Markdown table; integer columns printed in full, floats with ``floatfmt``."""
-    fmts = ["d" if pd.api.types.is_integer_dtype(t) else floatfmt for t in df.dtypes]
-    return df.to_markdown(index=False, floatfmt=fmts)
 
 
 def convergence_table(summary: pd.DataFrame, max_rows: int = 12) -> pd.DataFrame:

@@ -48,7 +48,7 @@ def _facets(n: int, ncols: int = 3, size: tuple[float, float] = (4.2, 3.4)):
 def rmse_figure(s: pd.DataFrame) -> plt.Figure:
     """RMSE (bootstrap 95% CI as bars) vs number of trajectories, per problem and scheme."""
     title = "RMSE of every estimator against the number of trajectories (pruned: largest N)"
-    return _metric_figure(s, "rmse", "RMSE", log_y=True, title=title)
+    return _metric_figure(s, "n_trajectories", "rmse", "RMSE", log_y=True, title=title)
 
 
 def bias_figure(s: pd.DataFrame) -> plt.Figure:
@@ -60,11 +60,15 @@ def bias_figure(s: pd.DataFrame) -> plt.Figure:
         rel_bias_high=s["bias_fraction_high"],
     )
     title = "Bias of every estimator, in units of the NBO error (pruned: largest N)"
-    return _metric_figure(scaled, "rel_bias", "bias / (J_NBO - J)", log_y=False, title=title)
+    ylabel = "bias / (J_NBO - J)"
+    return _metric_figure(scaled, "n_trajectories", "rel_bias", ylabel, log_y=False, title=title)
 
 
-def _metric_figure(s: pd.DataFrame, col: str, ylabel: str, log_y: bool, title: str) -> plt.Figure:
-    """One panel per problem: ``col`` with its ``col_low``/``col_high`` CI against n."""
+def _metric_figure(
+    s: pd.DataFrame, x: str, col: str, ylabel: str, log_y: bool, title: str, ci: bool = True
+) -> plt.Figure:
+    """One panel per problem, one line per scheme: ``col`` against ``x`` (log axis), with the
+    ``col_low``/``col_high`` CI as error bars when ``ci``."""
     theme()
     data = _main_schemes(s)
     problems = list(dict.fromkeys(data["problem"]))
@@ -74,11 +78,12 @@ def _metric_figure(s: pd.DataFrame, col: str, ylabel: str, log_y: bool, title: s
     for ax, problem in zip(axes, problems, strict=False):
         sub = data[data["problem"] == problem]
         for label, g in sub.groupby("label"):
-            g = g.sort_values("n_trajectories")
+            g = g.sort_values(x)
+            yerr = [g[col] - g[f"{col}_low"], g[f"{col}_high"] - g[col]] if ci else None
             ax.errorbar(
-                g["n_trajectories"],
+                g[x],
                 g[col],
-                yerr=[g[col] - g[f"{col}_low"], g[f"{col}_high"] - g[col]],
+                yerr=yerr,
                 marker="o",
                 ms=3,
                 lw=1.2,
@@ -86,7 +91,8 @@ def _metric_figure(s: pd.DataFrame, col: str, ylabel: str, log_y: bool, title: s
                 color=palette[label],
                 label=label,
             )
-        ax.set(xscale="log", title=problem, xlabel="trajectories n", ylabel=ylabel)
+        xlabel = "trajectories n" if x == "n_trajectories" else "CPU seconds per estimate"
+        ax.set(xscale="log", title=problem, xlabel=xlabel, ylabel=ylabel)
         if log_y:
             ax.set_yscale("log")
         else:
@@ -225,34 +231,5 @@ def pruning_heatmap(s: pd.DataFrame) -> plt.Figure:
 
 def frontier_figure(s: pd.DataFrame) -> plt.Figure:
     """RMSE vs median CPU seconds per estimate (log-log), every stochastic scheme."""
-    theme()
-    data = _main_schemes(s)
-    problems = list(dict.fromkeys(data["problem"]))
-    labels = sorted(data["label"].unique())
-    palette = dict(zip(labels, sns.color_palette("colorblind", len(labels)), strict=True))
-    fig, axes = _facets(len(problems))
-    for ax, problem in zip(axes, problems, strict=False):
-        sub = data[data["problem"] == problem]
-        for label, g in sub.groupby("label"):
-            g = g.sort_values("cpu_median")
-            ax.plot(
-                g["cpu_median"],
-                g["rmse"],
-                marker="o",
-                ms=3,
-                lw=1.2,
-                color=palette[label],
-                label=label,
-            )
-        ax.set(
-            xscale="log",
-            yscale="log",
-            title=problem,
-            xlabel="CPU seconds per estimate",
-            ylabel="RMSE",
-        )
-    handles, names = axes[0].get_legend_handles_labels()
-    fig.legend(handles, names, loc="lower right", fontsize=8, ncols=2)
-    fig.suptitle("Error vs CPU time (quadrature rules are exact here and not shown)")
-    fig.tight_layout()
-    return fig
+    title = "Error vs CPU time (quadrature rules are exact here and not shown)"
+    return _metric_figure(s, "cpu_median", "rmse", "RMSE", log_y=True, title=title, ci=False)
