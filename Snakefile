@@ -33,6 +33,7 @@ validate(config, "workflow/schemas/config.schema.yaml")
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/lqg.smk"
+include: "workflow/rules/uav.smk"
 include: "workflow/rules/report.smk"
 
 
@@ -40,4 +41,5 @@ rule all:
     default_target: True
     input:
         rules.lqg.input,
+        rules.uav.input,
         rules.report.output,

@@ -7,7 +7,7 @@ ENV = "../envs/rsmhp.yaml"
 
 # Report sections, in report order: key -> section JSON written by an aggregation rule.
 # Each experiment family adds its entry here (and its figures to REPORT_FIGURES).
-REPORT_SECTIONS = {"lqg": "results/report/lqg.json"}
+REPORT_SECTIONS = {"lqg": "results/report/lqg.json", "uav": "results/report/uav.json"}
 
 REPORT_FIGURES = []
 

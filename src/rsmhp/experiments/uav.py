@@ -15,12 +15,13 @@ from typing import Any
 import pandas as pd
 
 from rsmhp.parallel import chunked, parallel_map
-from rsmhp.uav.simulation import UAVSetup, method_specs, simulate_run
+from rsmhp.uav.simulation import MethodSpec, UAVSetup, simulate_run
 
 __all__ = [
     "NONDETERMINISTIC_COLUMNS",
     "RUN_COLUMNS",
     "STEP_COLUMNS",
+    "UAV_MODEL_KEYS",
     "chunk_runs",
     "run_chunk",
 ]
@@ -64,6 +65,8 @@ STEP_COLUMNS = [
     "nit",
     "kernel_calls",
 ]
+#: config keys of the ``uav`` section a simulation depends on (besides its method and the seed)
+UAV_MODEL_KEYS = ("dt", "g", "aircraft", "target", "sensor", "tracker", "scenario", "planner")
 #: wall-time columns: excluded from every determinism check
 NONDETERMINISTIC_COLUMNS = ("plan_seconds",)
 
@@ -76,25 +79,28 @@ def chunk_runs(n_runs: int, n_chunks: int, chunk: int) -> list[int]:
     return parts[chunk]
 
 
-def _one_run(job: tuple[Mapping[str, Any], str, int, int]) -> tuple[dict, list[dict]]:
-    uav, name, seed, run = job
-    setup = UAVSetup.from_config(uav)
-    method = method_specs(uav)[name]
-    summary, steps = simulate_run(setup, method, seed, run)
+def _one_run(job: tuple[Mapping[str, Any], MethodSpec, int, int]) -> tuple[dict, list[dict]]:
+    uav, method, seed, run = job
+    summary, steps = simulate_run(UAVSetup.from_config(uav), method, seed, run)
     for row in steps:
         row.update(method=method.name, N_T=method.n_traj, run=run)
     return summary, steps
 
 
 def run_chunk(
-    uav: Mapping[str, Any], method: str, runs: Sequence[int], seed: int, n_jobs: int = 1
+    uav: Mapping[str, Any],
+    method: MethodSpec | Mapping[str, Any],
+    runs: Sequence[int],
+    seed: int,
+    n_jobs: int = 1,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Simulate ``runs`` with ``method`` (a key of :func:`method_specs`): (runs, steps) tables."""
-    if method not in method_specs(uav):
-        raise ValueError(f"unknown UAV method {method!r}; configured: {list(method_specs(uav))}")
+    """Simulate ``runs`` with ``method`` (a :class:`MethodSpec` or its fields as a mapping):
+    (runs, steps) tables. ``uav`` needs the model sections only (not ``methods``)."""
+    if not isinstance(method, MethodSpec):
+        method = MethodSpec(**method)
     jobs = [(dict(uav), method, seed, int(r)) for r in runs]
-    log.info("uav %s: %d runs on %d workers", method, len(jobs), n_jobs)
-    out = parallel_map(_one_run, jobs, n_jobs, desc=f"uav {method} runs")
+    log.info("uav %s: %d runs on %d workers", method.name, len(jobs), n_jobs)
+    out = parallel_map(_one_run, jobs, n_jobs, desc=f"uav {method.name} runs")
     runs_df = pd.DataFrame([s for s, _ in out], columns=RUN_COLUMNS)
     steps_df = pd.DataFrame([r for _, rows in out for r in rows], columns=STEP_COLUMNS)
     return runs_df, steps_df
