@@ -34,6 +34,7 @@ validate(config, "workflow/schemas/config.schema.yaml")
 include: "workflow/rules/common.smk"
 include: "workflow/rules/lqg.smk"
 include: "workflow/rules/estimators.smk"
+include: "workflow/rules/uav.smk"
 include: "workflow/rules/report.smk"
 
 
@@ -42,4 +43,5 @@ rule all:
     input:
         rules.lqg.input,
         rules.estimators.input,
+        rules.uav.input,
         rules.report.output,

@@ -17,13 +17,15 @@ DEFAULT = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 def test_default_and_test_configs_are_valid():
     check_config(DEFAULT)
     tiny = yaml.safe_load((ROOT / "tests" / "config" / "tiny.yaml").read_text())
-    merged = copy.deepcopy(DEFAULT)
-    for section in ("lqg", "estimators"):
-        for k, v in tiny[section].items():
-            old = merged[section].get(k)
-            merged[section][k] = {**old, **v} if isinstance(old, dict) else v
-    merged["seed"], merged["threads"] = tiny["seed"], tiny["threads"]
-    check_config(merged)
+    check_config(_deep_merge(DEFAULT, tiny))
+
+
+def _deep_merge(base: dict, over: dict) -> dict:
+    """``over`` merged into a copy of ``base`` recursively (as snakemake merges configfiles)."""
+    out = copy.deepcopy(base)
+    for k, v in over.items():
+        out[k] = _deep_merge(out[k], v) if isinstance(v, dict) and k in out else v
+    return out
 
 
 def _with(path: str, value):
@@ -76,3 +78,20 @@ def test_all_problems_reported_at_once():
     with pytest.raises(ConfigError) as exc:
         check_config(cfg)
     assert "lqg.model.sigma" in str(exc.value) and "lqg.model.a" in str(exc.value)
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "expected"),
+    [
+        ("uav.aircraft.speed_min", 40.0, r"uav\.aircraft\.speed_min: 40\.0 is not < uav\.aircraft"),
+        ("uav.scenario.uav_speed", 50.0, r"uav\.scenario\.uav_speed: 50\.0 is outside"),
+        ("uav.scenario.uav_distance_min", 900.0, r"uav\.scenario\.uav_distance_min: 900\.0"),
+        ("uav.methods.tree", [{"N": 1, "M": 5}], r"uav\.methods\.tree\[0\]\.M: 5 is greater"),
+        ("uav.planner.horizon", 0, r"uav\.planner\.horizon: 0 .*allowed: integer in \[1, 50\]"),
+        ("uav.aircraft.bank_max_deg", 90, r"uav\.aircraft\.bank_max_deg: 90 .*\(0, 90\)"),
+        ("uav.methods.rsmhp_nt", [50, 50], r"uav\.methods\.rsmhp_nt"),
+    ],
+)
+def test_bad_uav_values_are_named(path, value, expected):
+    with pytest.raises(ConfigError, match=expected):
+        check_config(_with(path, value))

@@ -1,4 +1,7 @@
-"""End-to-end runs of the Snakemake workflow on tests/config/tiny.yaml in temporary directories."""
+"""End-to-end runs of the Snakemake workflow on tests/config/tiny.yaml in temporary directories.
+
+The full tiny run (``run_j2``, shared with tests/test_uav_workflow.py) is in conftest.py.
+"""
 
 from __future__ import annotations
 
@@ -49,19 +52,6 @@ def digest(workdir: Path) -> dict[str, str]:
     files = [p for p in sorted((workdir / "results").rglob("*")) if p.is_file()]
     files += [p for p in sorted((workdir / "paper").rglob("*")) if p.is_file()]
     return {str(p.relative_to(workdir)): hashlib.sha256(p.read_bytes()).hexdigest() for p in files}
-
-
-@pytest.fixture(scope="module")
-def run_j2(tmp_path_factory) -> Path:
-    wd = tmp_path_factory.mktemp("wf_j2")
-    res = snakemake(wd, "-j2")
-    assert res.returncode == 0, res.stderr[-3000:]
-    return wd
-
-
-@pytest.fixture(scope="module")
-def tiny() -> dict:
-    return yaml.safe_load(TINY.read_text())
 
 
 def test_outputs_content(run_j2, tiny):

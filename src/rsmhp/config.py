@@ -115,6 +115,41 @@ def _cross_field(config: Mapping[str, Any]) -> list[str]:
         val = (lqg.get("model", {}) or {}).get(key)
         if isinstance(val, float) and not math.isfinite(val):
             problems.append(f"lqg.model.{key}: {val} is not finite")
+    problems += _uav_cross_field(config.get("uav", {}) or {})
+    return problems
+
+
+def _uav_cross_field(uav: Mapping[str, Any]) -> list[str]:
+    """UAV bounds (lo <= hi), initial speed inside the speed range, tree able to keep M."""
+    problems = []
+    for section, lo, hi, strict in (
+        ("aircraft", "speed_min", "speed_max", True),
+        ("scenario", "target_speed_min", "target_speed_max", False),
+        ("scenario", "uav_distance_min", "uav_distance_max", False),
+    ):
+        node = uav.get(section, {}) or {}
+        if {lo, hi} <= node.keys() and (node[lo] >= node[hi] if strict else node[lo] > node[hi]):
+            rel = "<" if strict else "<="
+            problems.append(
+                f"uav.{section}.{lo}: {node[lo]} is not {rel} uav.{section}.{hi} = {node[hi]} "
+                f"(allowed: {lo} {rel} {hi})"
+            )
+    ac, sc = uav.get("aircraft", {}) or {}, uav.get("scenario", {}) or {}
+    if {"speed_min", "speed_max"} <= ac.keys() and "uav_speed" in sc:
+        if not ac["speed_min"] <= sc["uav_speed"] <= ac["speed_max"]:
+            problems.append(
+                f"uav.scenario.uav_speed: {sc['uav_speed']} is outside the aircraft's speed range "
+                f"(allowed: {ac['speed_min']} <= uav_speed <= {ac['speed_max']})"
+            )
+    horizon = (uav.get("planner", {}) or {}).get("horizon")
+    for i, tree in enumerate((uav.get("methods", {}) or {}).get("tree", []) or []):
+        if horizon is not None and {"N", "M"} <= tree.keys():
+            leaves = tree["N"] ** (horizon + 1)
+            if tree["M"] > leaves:
+                problems.append(
+                    f"uav.methods.tree[{i}].M: {tree['M']} is greater than the tree's "
+                    f"N^(H+1) = {leaves} leaves (allowed: 1 <= M <= N^(H+1))"
+                )
     return problems
 
 

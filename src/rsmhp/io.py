@@ -9,7 +9,7 @@ from pathlib import Path
 
 import pandas as pd
 
-__all__ = ["IntermediateFileError", "read_table", "write_csv", "write_text"]
+__all__ = ["IntermediateFileError", "read_table", "write_csv", "write_parquet", "write_text"]
 
 
 class IntermediateFileError(RuntimeError):
@@ -67,6 +67,11 @@ def _atomic(path: str | os.PathLike, write) -> None:
 def write_csv(df: pd.DataFrame, path: str | os.PathLike) -> None:
     """Write ``df`` atomically (temp file + rename) with full float precision, no index."""
     _atomic(path, lambda tmp: df.to_csv(tmp, index=False, lineterminator="\n"))
+
+
+def write_parquet(df: pd.DataFrame, path: str | os.PathLike) -> None:
+    """Write ``df`` atomically as Parquet (pyarrow), no index."""
+    _atomic(path, lambda tmp: df.to_parquet(tmp, index=False, engine="pyarrow"))
 
 
 def write_text(text: str, path: str | os.PathLike) -> None:

@@ -5,9 +5,10 @@ THREADS = config["threads"]
 # Software environment of every rule (used with --use-conda).
 ENV = "../envs/rsmhp.yaml"
 
-# Report sections, in report order: key -> section JSON written by an aggregation rule.
-# Each experiment family adds its entry here (and its figures to REPORT_FIGURES).
-REPORT_SECTIONS = {"lqg": "results/report/lqg.json"}
+# Report sections: key -> section JSON written by an aggregation rule. Each rule file
+# registers its own section here and its figures in REPORT_FIGURES; the order in the report
+# comes from each section's `order` field.
+REPORT_SECTIONS = {}
 
 REPORT_FIGURES = []
 

@@ -4,6 +4,7 @@
 
 LQG_TABLES = ["lqg_convergence", "lqg_nbo_error", "lqg_chebyshev"]
 LQG_FIGURES = ["lqg_convergence", "lqg_error_loglog", "lqg_nbo_error"]
+REPORT_SECTIONS["lqg"] = "results/report/lqg.json"
 REPORT_FIGURES.extend(LQG_FIGURES)
 
 

@@ -1,0 +1,106 @@
+"""UAV Monte-Carlo study (paper Sec. III-B, Figs. 4-5): one chunk of runs for one method.
+
+Every run seeds itself from its run index (:mod:`rsmhp.uav.simulation`), so chunking and the
+worker count never change a number. Outputs: one summary row per run (:data:`RUN_COLUMNS`)
+and one row per (run, step) (:data:`STEP_COLUMNS`). ``plan_seconds`` is wall time and the
+only non-deterministic column.
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import pandas as pd
+
+from rsmhp.parallel import chunked, parallel_map
+from rsmhp.uav.simulation import MethodSpec, UAVSetup, simulate_run
+
+__all__ = [
+    "NONDETERMINISTIC_COLUMNS",
+    "RUN_COLUMNS",
+    "STEP_COLUMNS",
+    "UAV_MODEL_KEYS",
+    "chunk_runs",
+    "run_chunk",
+]
+
+log = logging.getLogger(__name__)
+
+RUN_COLUMNS = [
+    "method",
+    "family",
+    "N_T",
+    "N",
+    "M",
+    "run",
+    "seed",
+    "mean_error",
+    "rmse",
+    "final_error",
+    "mean_trace",
+    "mean_nit",
+    "plan_seconds",
+]
+STEP_COLUMNS = [
+    "method",
+    "N_T",
+    "run",
+    "step",
+    "error",
+    "trace",
+    "uav_x",
+    "uav_y",
+    "uav_speed",
+    "uav_heading",
+    "target_x",
+    "target_y",
+    "est_x",
+    "est_y",
+    "accel",
+    "bank",
+    "plan_cost",
+    "plan_cost_warm",
+    "nit",
+    "kernel_calls",
+]
+#: config keys of the ``uav`` section a simulation depends on (besides its method and the seed)
+UAV_MODEL_KEYS = ("dt", "g", "aircraft", "target", "sensor", "tracker", "scenario", "planner")
+#: wall-time columns: excluded from every determinism check
+NONDETERMINISTIC_COLUMNS = ("plan_seconds",)
+
+
+def chunk_runs(n_runs: int, n_chunks: int, chunk: int) -> list[int]:
+    """Run indices of chunk ``chunk`` (0-based) when ``n_runs`` runs are split in ``n_chunks``."""
+    parts = chunked(list(range(n_runs)), n_chunks)
+    if not 0 <= chunk < len(parts):
+        raise ValueError(f"chunk {chunk} out of range: {n_runs} runs make {len(parts)} chunks")
+    return parts[chunk]
+
+
+def _one_run(job: tuple[Mapping[str, Any], MethodSpec, int, int]) -> tuple[dict, list[dict]]:
+    uav, method, seed, run = job
+    summary, steps = simulate_run(UAVSetup.from_config(uav), method, seed, run)
+    for row in steps:
+        row.update(method=method.name, N_T=method.n_traj, run=run)
+    return summary, steps
+
+
+def run_chunk(
+    uav: Mapping[str, Any],
+    method: MethodSpec | Mapping[str, Any],
+    runs: Sequence[int],
+    seed: int,
+    n_jobs: int = 1,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Simulate ``runs`` with ``method`` (a :class:`MethodSpec` or its fields as a mapping):
+    (runs, steps) tables. ``uav`` needs the model sections only (not ``methods``)."""
+    if not isinstance(method, MethodSpec):
+        method = MethodSpec(**method)
+    jobs = [(dict(uav), method, seed, int(r)) for r in runs]
+    log.info("uav %s: %d runs on %d workers", method.name, len(jobs), n_jobs)
+    out = parallel_map(_one_run, jobs, n_jobs, desc=f"uav {method.name} runs")
+    runs_df = pd.DataFrame([s for s, _ in out], columns=RUN_COLUMNS)
+    steps_df = pd.DataFrame([r for _, rows in out for r in rows], columns=STEP_COLUMNS)
+    return runs_df, steps_df

@@ -1,0 +1,135 @@
+r"""The planner's objective kernel: Kalman covariance recursions for many hypotheses at once.
+
+For ``C`` candidate control sequences (UAV positions ``uav_xy`` (C, H, 2)) and ``T`` target
+hypotheses (positions ``target_xy`` (T, H, 2)) the kernel runs, for every pair (c, i) and
+:math:`j = 1..H`, the Kalman covariance recursion of :mod:`rsmhp.uav.tracker`
+
+.. math::
+    P^-_j = F P_{j-1} F^T + Q, \quad S_j = H P^-_j H^T + R_j, \quad
+    P_j = P^-_j - P^-_j H^T S_j^{-1} H P^-_j,
+
+with :math:`R_j = R(\mathrm{uav}_{c,j}, \mathrm{target}_{i,j})` and :math:`P_0 = \hat P`, and
+returns the traces :math:`\mathrm{tr}\,P_j` (C, T, H). The planner's cost of candidate c is
+:math:`\frac1T \sum_i \sum_{j=1}^H \mathrm{tr}\, P_j^{c,i}` (:func:`objective`).
+
+Structure used (exact, not approximations): write :math:`P = [[A, B], [B^T, C]]` with
+2x2 blocks (A, C symmetric) and :math:`F = [[I, \Delta t I], [0, I]]`, :math:`H = [I\ 0]`:
+
+.. math::
+    A^- = A + \Delta t (B + B^T) + \Delta t^2 C + Q_A, \quad B^- = B + \Delta t C + Q_B,
+    \quad C^- = C + Q_C, \\
+    S = A^- + R, \quad A^+ = A^- - A^- S^{-1} A^-, \quad B^+ = B^- - A^- S^{-1} B^-,
+    \quad C^+ = C^- - B^{-T} S^{-1} B^-,
+
+with the closed-form 2x2 inverse :math:`S^{-1} = \mathrm{adj}(S)/\det S`. The 10 distinct
+entries of P are carried as arrays of shape (C, T); only upper triangles of the symmetric
+blocks are formed, so symmetry holds exactly. The form :math:`P^- - K S K^T` (not Joseph)
+is used; it agrees with filterpy's Joseph form to rounding error.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rsmhp.uav.sensor import SensorModel, measurement_cov_entries
+
+__all__ = ["covariance_traces", "objective"]
+
+
+def covariance_traces(
+    P0: np.ndarray,
+    uav_xy: np.ndarray,
+    target_xy: np.ndarray,
+    dt: float,
+    Q: np.ndarray,
+    sensor: SensorModel,
+    *,
+    return_cov: bool = False,
+) -> np.ndarray | tuple[np.ndarray, np.ndarray]:
+    """Traces ``tr P_j`` of shape (C, T, H) (see module docstring).
+
+    ``P0`` (4, 4) is the current posterior; ``uav_xy`` (C, H, 2); ``target_xy`` (T, H, 2);
+    ``Q`` (4, 4) symmetric. With ``return_cov`` also the full covariances (C, T, H, 4, 4)
+    (slow path for tests).
+    """
+    uav_xy = np.asarray(uav_xy, dtype=float)
+    target_xy = np.asarray(target_xy, dtype=float)
+    n_c, horizon = uav_xy.shape[:2]
+    n_t = target_xy.shape[0]
+    shape = (n_c, n_t)
+    P0 = 0.5 * (np.asarray(P0, dtype=float) + np.asarray(P0, dtype=float).T)
+    full = lambda v: np.full(shape, v)  # noqa: E731
+    a11, a12, a22 = full(P0[0, 0]), full(P0[0, 1]), full(P0[1, 1])
+    b11, b12, b21, b22 = full(P0[0, 2]), full(P0[0, 3]), full(P0[1, 2]), full(P0[1, 3])
+    c11, c12, c22 = full(P0[2, 2]), full(P0[2, 3]), full(P0[3, 3])
+    qa11, qa12, qa22 = Q[0, 0], Q[0, 1], Q[1, 1]
+    qb11, qb12, qb21, qb22 = Q[0, 2], Q[0, 3], Q[1, 2], Q[1, 3]
+    qc11, qc12, qc22 = Q[2, 2], Q[2, 3], Q[3, 3]
+    dt2 = dt * dt
+    # R for every (candidate, hypothesis, step): (C, T, H) each
+    rxx, rxy, ryy = measurement_cov_entries(uav_xy[:, None, :, :], target_xy[None, :, :, :], sensor)
+    traces = np.empty((n_c, n_t, horizon))
+    covs = np.empty((n_c, n_t, horizon, 4, 4)) if return_cov else None
+    for j in range(horizon):
+        # predict
+        pa11 = a11 + 2 * dt * b11 + dt2 * c11 + qa11
+        pa12 = a12 + dt * (b12 + b21) + dt2 * c12 + qa12
+        pa22 = a22 + 2 * dt * b22 + dt2 * c22 + qa22
+        pb11 = b11 + dt * c11 + qb11
+        pb12 = b12 + dt * c12 + qb12
+        pb21 = b21 + dt * c12 + qb21
+        pb22 = b22 + dt * c22 + qb22
+        pc11, pc12, pc22 = c11 + qc11, c12 + qc12, c22 + qc22
+        # innovation covariance and its inverse (adjugate / determinant)
+        s11 = pa11 + rxx[:, :, j]
+        s12 = pa12 + rxy[:, :, j]
+        s22 = pa22 + ryy[:, :, j]
+        inv_det = 1.0 / (s11 * s22 - s12 * s12)
+        i11, i12, i22 = s22 * inv_det, -s12 * inv_det, s11 * inv_det
+        # M = S^-1 A^-  (2x2), N = S^-1 B^-  (2x2)
+        m11 = i11 * pa11 + i12 * pa12
+        m12 = i11 * pa12 + i12 * pa22
+        m21 = i12 * pa11 + i22 * pa12
+        m22 = i12 * pa12 + i22 * pa22
+        n11 = i11 * pb11 + i12 * pb21
+        n12 = i11 * pb12 + i12 * pb22
+        n21 = i12 * pb11 + i22 * pb21
+        n22 = i12 * pb12 + i22 * pb22
+        # update: A+ = A- - A- M, B+ = B- - A- N, C+ = C- - B-^T N
+        a11 = pa11 - (pa11 * m11 + pa12 * m21)
+        a12 = pa12 - (pa11 * m12 + pa12 * m22)
+        a22 = pa22 - (pa12 * m12 + pa22 * m22)
+        b11 = pb11 - (pa11 * n11 + pa12 * n21)
+        b12 = pb12 - (pa11 * n12 + pa12 * n22)
+        b21 = pb21 - (pa12 * n11 + pa22 * n21)
+        b22 = pb22 - (pa12 * n12 + pa22 * n22)
+        c11 = pc11 - (pb11 * n11 + pb21 * n21)
+        c12 = pc12 - (pb11 * n12 + pb21 * n22)
+        c22 = pc22 - (pb12 * n12 + pb22 * n22)
+        traces[:, :, j] = a11 + a22 + c11 + c22
+        if covs is not None:
+            rows = (
+                (a11, a12, b11, b12),
+                (a12, a22, b21, b22),
+                (b11, b21, c11, c12),
+                (b12, b22, c12, c22),
+            )
+            for r, row in enumerate(rows):
+                for col, val in enumerate(row):
+                    covs[:, :, j, r, col] = val
+    if return_cov:
+        return traces, covs
+    return traces
+
+
+def objective(
+    P0: np.ndarray,
+    uav_xy: np.ndarray,
+    target_xy: np.ndarray,
+    dt: float,
+    Q: np.ndarray,
+    sensor: SensorModel,
+) -> np.ndarray:
+    r"""Cost per candidate (C,): :math:`\frac1T\sum_{i=1}^T\sum_{j=1}^H \mathrm{tr} P_j^{c,i}`
+    (m² + m²/s², summed as the paper's trace)."""
+    return covariance_traces(P0, uav_xy, target_xy, dt, Q, sensor).sum(axis=2).mean(axis=1)

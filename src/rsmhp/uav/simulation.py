@@ -1,0 +1,260 @@
+r"""One closed-loop Monte-Carlo run of the UAV tracking problem for one planning method.
+
+Run ``r`` (paired design: identical for every method)
+-----------------------------------------------------
+* **Scenario** from ``job_rng(seed, "uav_scenario", run=r)``, in this order: target start
+  position uniform in :math:`[-b, b]^2`, heading uniform in :math:`[0, 2\pi)`, speed uniform in
+  ``[v_min, v_max]``; UAV distance uniform in ``[d_min, d_max]`` at a uniform bearing from the
+  target, UAV heading uniform, speed ``uav_speed``; then the initial estimate error
+  :math:`\hat x_0 - x_0 \sim \mathcal N(0, P_0)`, :math:`P_0 = \mathrm{diag}(\sigma_p^2,
+  \sigma_p^2, \sigma_v^2, \sigma_v^2)`.
+* **Truth process noise** :math:`w_1..w_K \sim \mathcal N(0, Q)` from
+  ``job_rng(seed, "uav_process_noise", run=r)`` as one (K, 4) standard-normal block times
+  :math:`\mathrm{chol}(Q)^T`.
+* **Measurement noise**: standard normals :math:`\zeta_1..\zeta_K` (K, 2) from
+  ``job_rng(seed, "uav_measurement_noise", run=r)``; the noise at step k is
+  :math:`v_k = G_k \mathrm{diag}(\sigma_r, \sigma_c)_k \zeta_k` with the *true* geometry of the
+  method's own UAV (:func:`rsmhp.uav.sensor.measurement_noise`). Every method therefore sees
+  the same scenario, target path and :math:`\zeta`; only geometry-dependent scaling differs.
+
+Planner hypotheses (method-specific)
+------------------------------------
+At step k the planner's hypotheses come from
+``job_rng(seed, "uav_plan", run=r, step=k, method=<name>, N_T=..., N=..., M=...)``:
+drawn once per planning step and held fixed during the optimisation.
+
+Step k = 1..K
+-------------
+plan from (UAV state, :math:`\hat x_{k-1}, \hat P_{k-1}`) -> apply :math:`u_0` -> target moves
+:math:`x_k = F x_{k-1} + w_k` -> tracker predicts -> :math:`z_k = H x_k + v_k` -> tracker
+updates with R at the predicted estimate -> error :math:`e_k = \|\hat p_k - p_k\|`.
+Metric of the run: ``mean_error`` :math:`= \frac1K \sum_k e_k` (paper's average target location
+error), ``rmse`` :math:`= (\frac1K\sum_k e_k^2)^{1/2}`, ``mean_trace`` = mean of
+:math:`\mathrm{tr}\,\hat P_k`. ``plan_seconds`` is planner wall time (the only
+non-deterministic output).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rsmhp.seeding import job_rng
+from rsmhp.uav import kinematics, sensor, target
+from rsmhp.uav.kinematics import UAVParams
+from rsmhp.uav.planner import PlannerParams, PlanningProblem, plan, shift_plan
+from rsmhp.uav.sensor import SensorModel
+from rsmhp.uav.target import TargetModel
+from rsmhp.uav.tracker import Tracker
+
+__all__ = [
+    "MethodSpec",
+    "Scenario",
+    "StepInfo",
+    "UAVSetup",
+    "draw_scenario",
+    "method_specs",
+    "simulate_run",
+]
+
+
+@dataclass(frozen=True)
+class MethodSpec:
+    """A planning method: ``family`` in {nbo, rsmhp, tree}; ``n_traj`` = N_T (trajectories the
+    cost averages over: 1 for NBO, N_T for RS-MHP, M for the pruned tree)."""
+
+    name: str
+    family: str
+    n_traj: int
+    n_branch: int | None = None
+    max_keep: int | None = None
+
+    def job_params(self) -> dict[str, Any]:
+        """The method's part of a job identifier."""
+        return {"method": self.name, "N_T": self.n_traj, "N": self.n_branch, "M": self.max_keep}
+
+
+def method_specs(uav: Mapping[str, Any]) -> dict[str, MethodSpec]:
+    """Methods of the ``uav.methods`` config section, keyed by name (the rule wildcard):
+    ``nbo``, ``rsmhp_nt<N_T>`` for each N_T, ``tree_n<N>_m<M>`` for each tree ablation."""
+    m = uav["methods"]
+    out: dict[str, MethodSpec] = {}
+    if m["nbo"]:
+        out["nbo"] = MethodSpec("nbo", "nbo", 1)
+    for n in m["rsmhp_nt"]:
+        out[f"rsmhp_nt{n}"] = MethodSpec(f"rsmhp_nt{n}", "rsmhp", int(n))
+    for t in m["tree"]:
+        name = f"tree_n{t['N']}_m{t['M']}"
+        out[name] = MethodSpec(name, "tree", int(t["M"]), int(t["N"]), int(t["M"]))
+    return out
+
+
+@dataclass(frozen=True)
+class UAVSetup:
+    """Every model constant of the case study (built from the ``uav`` config section)."""
+
+    uav: UAVParams
+    target: TargetModel
+    sensor: SensorModel
+    planner: PlannerParams
+    P0: np.ndarray
+    steps: int
+    scenario: Mapping[str, float]
+
+    @classmethod
+    def from_config(cls, uav: Mapping[str, Any]) -> UAVSetup:
+        tr = uav["tracker"]
+        P0 = np.diag([tr["p0_pos_sd"] ** 2] * 2 + [tr["p0_vel_sd"] ** 2] * 2).astype(float)
+        return cls(
+            uav=UAVParams.from_config(uav),
+            target=TargetModel.from_config(uav),
+            sensor=SensorModel.from_config(uav),
+            planner=PlannerParams.from_config(uav),
+            P0=P0,
+            steps=int(uav["scenario"]["steps"]),
+            scenario=dict(uav["scenario"]),
+        )
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """Initial truth (target (4,), UAV (4,)) and the tracker's initial estimate (4,)."""
+
+    target: np.ndarray
+    uav: np.ndarray
+    estimate: np.ndarray
+
+
+def draw_scenario(setup: UAVSetup, seed: int, run: int) -> Scenario:
+    """The run's scenario (see the module docstring for the draw order)."""
+    sc = setup.scenario
+    rng = job_rng(seed, "uav_scenario", run=run)
+    pos = rng.uniform(-sc["target_box"], sc["target_box"], 2)
+    heading = rng.uniform(0.0, 2 * math.pi)
+    speed = rng.uniform(sc["target_speed_min"], sc["target_speed_max"])
+    dist = rng.uniform(sc["uav_distance_min"], sc["uav_distance_max"])
+    bearing = rng.uniform(0.0, 2 * math.pi)
+    uav_heading = rng.uniform(0.0, 2 * math.pi)
+    tgt = np.array([*pos, speed * math.cos(heading), speed * math.sin(heading)])
+    uav_xy = pos + dist * np.array([math.cos(bearing), math.sin(bearing)])
+    uav = np.array([*uav_xy, float(sc["uav_speed"]), uav_heading])
+    est = tgt + rng.standard_normal(4) @ np.linalg.cholesky(setup.P0).T
+    return Scenario(target=tgt, uav=uav, estimate=est)
+
+
+@dataclass
+class StepInfo:
+    """What happened at step k (for recordings): states after the step, the plan made before it
+    (planned UAV states (H, 4), hypotheses (T, H, 4)), error and tr P."""
+
+    step: int
+    uav: np.ndarray
+    target: np.ndarray
+    estimate: np.ndarray
+    covariance: np.ndarray
+    plan_path: np.ndarray
+    hypotheses: np.ndarray
+    error: float
+    trace: float
+
+
+def _hypotheses(
+    method: MethodSpec, x_hat: np.ndarray, P_hat: np.ndarray, setup: UAVSetup, rng
+) -> np.ndarray:
+    H = setup.planner.horizon
+    if method.family == "nbo":
+        return target.nominal(x_hat, H, setup.target)
+    if method.family == "rsmhp":
+        return target.sample_independent(x_hat, P_hat, H, method.n_traj, setup.target, rng)
+    if method.family == "tree":
+        states, _ = target.sample_tree(
+            x_hat, P_hat, H, method.n_branch, method.max_keep, setup.target, rng
+        )
+        return states
+    raise ValueError(f"unknown method family {method.family!r}")
+
+
+def simulate_run(
+    setup: UAVSetup,
+    method: MethodSpec,
+    seed: int,
+    run: int,
+    observer: Callable[[StepInfo], None] | None = None,
+) -> tuple[dict[str, Any], list[dict[str, Any]]]:
+    """Simulate run ``run`` with ``method``: (summary row, per-step rows)."""
+    sc = draw_scenario(setup, seed, run)
+    K, H = setup.steps, setup.planner.horizon
+    w = job_rng(seed, "uav_process_noise", run=run).standard_normal((K, 4))
+    w = w @ np.linalg.cholesky(setup.target.Q).T
+    zeta = job_rng(seed, "uav_measurement_noise", run=run).standard_normal((K, 2))
+    F = setup.target.F
+    x_true, uav_state = sc.target.copy(), sc.uav.copy()
+    trk = Tracker(sc.estimate, setup.P0, setup.target)
+    warm = np.zeros((H, 2))
+    rows: list[dict[str, Any]] = []
+    plan_seconds = 0.0
+    for k in range(1, K + 1):
+        x_hat, P_hat = trk.x, trk.P
+        t0 = time.perf_counter()
+        rng = job_rng(seed, "uav_plan", run=run, step=k, **method.job_params())
+        hyp = _hypotheses(method, x_hat, P_hat, setup, rng)
+        problem = PlanningProblem(
+            uav_state, P_hat, hyp[..., :2], setup.uav, setup.target, setup.sensor, setup.planner
+        )
+        res = plan(problem, warm)
+        plan_seconds += time.perf_counter() - t0
+        warm = shift_plan(res.controls)
+        uav_state = kinematics.step(uav_state, res.controls[0], setup.uav)
+        x_true = F @ x_true + w[k - 1]
+        trk.predict()
+        R_est = sensor.measurement_cov(uav_state[:2], trk.x[:2], setup.sensor)
+        v = sensor.measurement_noise(uav_state[:2], x_true[:2], setup.sensor, zeta[k - 1])
+        trk.update(x_true[:2] + v, R_est)
+        x_est, P_est = trk.x, trk.P
+        err = float(np.hypot(*(x_est[:2] - x_true[:2])))
+        tr = float(np.trace(P_est))
+        rows.append(
+            {
+                "step": k,
+                "error": err,
+                "trace": tr,
+                "uav_x": uav_state[0],
+                "uav_y": uav_state[1],
+                "uav_speed": uav_state[2],
+                "uav_heading": uav_state[3],
+                "target_x": x_true[0],
+                "target_y": x_true[1],
+                "est_x": x_est[0],
+                "est_y": x_est[1],
+                "accel": res.controls[0, 0],
+                "bank": res.controls[0, 1],
+                "plan_cost": res.cost,
+                "plan_cost_warm": res.cost_warm,
+                "nit": res.nit,
+                "kernel_calls": res.n_kernel_calls,
+            }
+        )
+        if observer is not None:
+            observer(StepInfo(k, uav_state, x_true, x_est, P_est, res.uav_path, hyp, err, tr))
+    errors = np.array([r["error"] for r in rows])
+    summary = {
+        "method": method.name,
+        "family": method.family,
+        "N_T": method.n_traj,
+        "N": method.n_branch if method.n_branch is not None else 0,
+        "M": method.max_keep if method.max_keep is not None else 0,
+        "run": run,
+        "seed": seed,
+        "mean_error": float(errors.mean()),
+        "rmse": float(np.sqrt(np.mean(errors**2))),
+        "final_error": float(errors[-1]),
+        "mean_trace": float(np.mean([r["trace"] for r in rows])),
+        "mean_nit": float(np.mean([r["nit"] for r in rows])),
+        "plan_seconds": plan_seconds,
+    }
+    return summary, rows

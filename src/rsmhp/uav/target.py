@@ -1,0 +1,161 @@
+r"""Near-constant-velocity (NCV) target and its sampled future hypotheses.
+
+State :math:`x = (p_x, p_y, v_x, v_y)` (m, m/s), :math:`x_{k+1} = F x_k + w_k`,
+:math:`w_k \sim \mathcal N(0, Q)` with
+
+.. math::
+    F = \begin{bmatrix} I_2 & \Delta t\, I_2 \\ 0 & I_2 \end{bmatrix}, \qquad
+    Q = q \begin{bmatrix} \tfrac{\Delta t^3}{3} I_2 & \tfrac{\Delta t^2}{2} I_2 \\
+    \tfrac{\Delta t^2}{2} I_2 & \Delta t\, I_2 \end{bmatrix}
+    \quad (q \text{ in m}^2/\text{s}^3).
+
+Planner hypotheses are arrays of future target states ``(n_traj, H, 4)``: entry ``j`` is the
+state ``j + 1`` steps ahead. Three generators:
+
+* :func:`nominal` (NBO): one trajectory, :math:`x_j = F^j \hat x` (all noise at its mean 0).
+* :func:`sample_independent` (RS-MHP, non-overlapping): ``n`` trajectories,
+  :math:`x_0^i \sim \mathcal N(\hat x, \hat P)`, :math:`x_j^i = F x_{j-1}^i + w_j^i`.
+* :func:`sample_tree` (RS-MHP, tree with pruning): level 0 draws ``N`` initial states, every
+  later level draws ``N`` process-noise values shared by all nodes of the level and branches
+  every node ``N`` ways; after each level only the ``M`` trajectories of highest likeliness
+  survive. Likeliness of a draw is its Gaussian density (of :math:`x_0` under
+  :math:`\mathcal N(\hat x, \hat P)`, of :math:`w` under :math:`\mathcal N(0, Q)`); a
+  trajectory's likeliness is the product, kept as a sum of logs. This is the convention of
+  :mod:`rsmhp.sampling`, with the initial-state draw as an extra tree level.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from rsmhp.sampling import GaussianNoise, top_m
+
+__all__ = [
+    "TargetModel",
+    "nominal",
+    "process_noise",
+    "sample_independent",
+    "sample_tree",
+    "transition_matrix",
+]
+
+
+def transition_matrix(dt: float) -> np.ndarray:
+    """NCV transition matrix F (4, 4)."""
+    F = np.eye(4)
+    F[0, 2] = F[1, 3] = dt
+    return F
+
+
+def process_noise(dt: float, q: float) -> np.ndarray:
+    """NCV process-noise covariance Q (4, 4), white-noise acceleration of intensity ``q``."""
+    Q = np.zeros((4, 4))
+    for i in range(2):
+        Q[i, i] = dt**3 / 3
+        Q[i, i + 2] = Q[i + 2, i] = dt**2 / 2
+        Q[i + 2, i + 2] = dt
+    return q * Q
+
+
+@dataclass(frozen=True)
+class TargetModel:
+    """NCV model with time step ``dt`` (s) and noise intensity ``q`` (m²/s³)."""
+
+    dt: float
+    q: float
+
+    @classmethod
+    def from_config(cls, uav: Mapping[str, Any]) -> TargetModel:
+        return cls(dt=float(uav["dt"]), q=float(uav["target"]["q"]))
+
+    @property
+    def F(self) -> np.ndarray:
+        return transition_matrix(self.dt)
+
+    @property
+    def Q(self) -> np.ndarray:
+        return process_noise(self.dt, self.q)
+
+
+def _chol(P: np.ndarray) -> np.ndarray:
+    """Cholesky factor of the symmetrised covariance."""
+    return np.linalg.cholesky(0.5 * (P + P.T))
+
+
+def _propagate(x0: np.ndarray, w: np.ndarray, F: np.ndarray) -> np.ndarray:
+    """``x0`` (n, 4), ``w`` (n, H, 4) -> states (n, H, 4) with x_j = F x_{j-1} + w_j."""
+    out = np.empty_like(w)
+    cur = x0
+    for j in range(w.shape[1]):
+        cur = cur @ F.T + w[:, j]
+        out[:, j] = cur
+    return out
+
+
+def nominal(x_hat: np.ndarray, horizon: int, model: TargetModel) -> np.ndarray:
+    """NBO hypothesis: ``(1, H, 4)`` with :math:`x_j = F^j \\hat x`."""
+    x0 = np.asarray(x_hat, dtype=float).reshape(1, 4)
+    return _propagate(x0, np.zeros((1, horizon, 4)), model.F)
+
+
+def sample_independent(
+    x_hat: np.ndarray,
+    P_hat: np.ndarray,
+    horizon: int,
+    n: int,
+    model: TargetModel,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """``n`` non-overlapping hypotheses ``(n, H, 4)``.
+
+    Stream order: ``n x 4`` standard normals for the initial states, then ``n x H x 4`` for the
+    process noise.
+    """
+    z0 = rng.standard_normal((n, 4))
+    x0 = np.asarray(x_hat, dtype=float) + z0 @ _chol(P_hat).T
+    w = rng.standard_normal((n, horizon, 4)) @ _chol(model.Q).T
+    return _propagate(x0, w, model.F)
+
+
+def sample_tree(
+    x_hat: np.ndarray,
+    P_hat: np.ndarray,
+    horizon: int,
+    n_branch: int,
+    max_keep: int,
+    model: TargetModel,
+    rng: np.random.Generator,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Pruned tree of hypotheses: ``(states (m, H, 4), log_likeliness (m,))``, ``m <= M``.
+
+    Level 0: ``N`` initial states from :math:`\\mathcal N(\\hat x, \\hat P)` (pruned to M if
+    ``N > M``). Level ``j = 1..H``: ``N`` noise values :math:`w_j^b \\sim \\mathcal N(0, Q)`
+    shared by the level; each surviving node ``i`` spawns children
+    :math:`F x^i + w_j^b`; keep the ``M`` children with the largest summed log-density
+    (ties by index, :func:`rsmhp.sampling.top_m`). Survivors are sorted by decreasing
+    likeliness.
+    """
+    init = GaussianNoise(0.5 * (P_hat + P_hat.T))
+    noise = GaussianNoise(model.Q)
+    d0 = init.sample(rng, n_branch)
+    loglik = init.logpdf(d0)
+    keep = top_m(loglik, max_keep)
+    x = np.asarray(x_hat, dtype=float) + d0[keep]
+    loglik = loglik[keep]
+    paths = np.empty((len(keep), 0, 4))
+    F = model.F
+    for _ in range(horizon):
+        w = noise.sample(rng, n_branch)  # shared by every node of this level
+        lw = noise.logpdf(w)
+        child = (x @ F.T)[:, None, :] + w[None, :, :]  # (nodes, N, 4)
+        child_ll = (loglik[:, None] + lw[None, :]).ravel()
+        parent = np.repeat(np.arange(len(x)), n_branch)
+        keep = top_m(child_ll, max_keep)
+        x = child.reshape(-1, 4)[keep]
+        paths = np.concatenate([paths[parent[keep]], x[:, None, :]], axis=1)
+        loglik = child_ll[keep]
+    return paths, loglik

@@ -1,0 +1,46 @@
+r"""The simulation's target tracker: a linear Kalman filter (filterpy) on the NCV model.
+
+Predict with :math:`F, Q` (:mod:`rsmhp.uav.target`); update with :math:`H = [I_2\ 0]` and the
+geometry-dependent :math:`R` (:mod:`rsmhp.uav.sensor`) evaluated by the caller at the tracker's
+*predicted* target position (the true geometry is unknown to the tracker). filterpy updates the
+covariance in Joseph form, :math:`P^+ = (I-KH)P^-(I-KH)^T + K R K^T`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from filterpy.kalman import KalmanFilter
+
+from rsmhp.uav.target import TargetModel
+
+__all__ = ["MEASUREMENT_MATRIX", "Tracker"]
+
+MEASUREMENT_MATRIX = np.hstack([np.eye(2), np.zeros((2, 2))])
+
+
+class Tracker:
+    """Thin wrapper: state ``x`` (4,), covariance ``P`` (4, 4), ``predict()``, ``update(z, R)``."""
+
+    def __init__(self, x0: np.ndarray, P0: np.ndarray, model: TargetModel) -> None:
+        kf = KalmanFilter(dim_x=4, dim_z=2)
+        kf.F = model.F
+        kf.Q = model.Q
+        kf.H = MEASUREMENT_MATRIX.copy()
+        kf.x = np.asarray(x0, dtype=float).reshape(4, 1).copy()
+        kf.P = np.asarray(P0, dtype=float).copy()
+        self.kf = kf
+
+    @property
+    def x(self) -> np.ndarray:
+        return self.kf.x[:, 0].copy()
+
+    @property
+    def P(self) -> np.ndarray:
+        return self.kf.P.copy()
+
+    def predict(self) -> None:
+        self.kf.predict()
+
+    def update(self, z: np.ndarray, R: np.ndarray) -> None:
+        """Measurement update; ``z`` (2,) is passed to filterpy as a (2, 1) column."""
+        self.kf.update(np.asarray(z, dtype=float).reshape(2, 1), R=np.asarray(R, dtype=float))

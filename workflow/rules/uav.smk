@@ -1,0 +1,157 @@
+# Case study 2: UAV target tracking (paper Sec. III-B, Figs. 4-5).
+# One simulation job per (method, chunk of runs), joblib over runs inside; then collection,
+# aggregation (tables, report section), figures and recordings as separate rules.
+import dataclasses
+import re
+
+from rsmhp.experiments.uav import UAV_MODEL_KEYS, chunk_runs
+from rsmhp.uav.simulation import method_specs
+
+UAV = config["uav"]
+UAV_SPECS = method_specs(UAV)
+UAV_METHODS = list(UAV_SPECS)
+UAV_CHUNKS = list(range(min(UAV["chunks"], UAV["runs"])))
+UAV_RECORDED = list(range(min(UAV["recording"]["runs"], UAV["runs"])))
+UAV_TABLES = ["uav_methods", "uav_paired"]
+UAV_FIGURES = ["uav_error_cdf_nt", "uav_error_cdf_nbo", "uav_paired_diff"]
+REPORT_SECTIONS["uav"] = "results/report/uav.json"
+REPORT_FIGURES.extend(UAV_FIGURES)
+
+
+wildcard_constraints:
+    method="|".join(re.escape(m) for m in UAV_METHODS),
+    chunk=r"\d+",
+    k=r"\d+",
+
+
+rule uav_simulate:
+    output:
+        runs="results/uav/chunks/{method}/{chunk}.csv",
+        steps="results/uav/chunks/{method}/{chunk}.parquet",
+    log:
+        "results/logs/uav_simulate/{method}_{chunk}.log",
+    benchmark:
+        "results/benchmarks/uav_simulate/{method}_{chunk}.tsv"
+    conda:
+        ENV
+    threads: THREADS
+    resources:
+        mem_mb=2000,
+        runtime=30,
+    params:
+        # the model, this method's own spec and this chunk's runs: adding an N_T value or a
+        # figure option reruns no existing simulation
+        uav=pick(UAV, *UAV_MODEL_KEYS),
+        method=lambda wc: dataclasses.asdict(UAV_SPECS[wc.method]),
+        runs=lambda wc: chunk_runs(UAV["runs"], len(UAV_CHUNKS), int(wc.chunk)),
+        seed=config["seed"],
+    script:
+        "../scripts/uav_simulate.py"
+
+
+rule uav_collect:
+    input:
+        runs=expand(
+            "results/uav/chunks/{method}/{chunk}.csv",
+            method=UAV_METHODS,
+            chunk=UAV_CHUNKS,
+        ),
+        steps=expand(
+            "results/uav/chunks/{method}/{chunk}.parquet",
+            method=UAV_METHODS,
+            chunk=UAV_CHUNKS,
+        ),
+    output:
+        runs="results/uav/runs.csv",
+        steps="results/uav/steps.parquet",
+    log:
+        "results/logs/uav_collect.log",
+    benchmark:
+        "results/benchmarks/uav_collect.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
+    params:
+        methods=UAV_METHODS,
+    script:
+        "../scripts/uav_collect.py"
+
+
+rule uav_summary:
+    input:
+        runs="results/uav/runs.csv",
+    output:
+        summary="results/uav/summary.csv",
+        paired="results/uav/paired.csv",
+        tables=expand("results/tables/{name}.{ext}", name=UAV_TABLES, ext=("md",)),
+        section="results/report/uav.json",
+    log:
+        "results/logs/uav_summary.log",
+    benchmark:
+        "results/benchmarks/uav_summary.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
+    params:
+        analysis=canonical(UAV["analysis"]),
+        setting=pick(UAV, *UAV_MODEL_KEYS),
+        seed=config["seed"],
+    script:
+        "../scripts/uav_summary.py"
+
+
+rule uav_figures:
+    input:
+        runs="results/uav/runs.csv",
+        summary="results/uav/summary.csv",
+        paired="results/uav/paired.csv",
+    output:
+        expand("results/figures/{name}.{ext}", name=UAV_FIGURES, ext=("png", "pdf")),
+    log:
+        "results/logs/uav_figures.log",
+    benchmark:
+        "results/benchmarks/uav_figures.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
+    script:
+        "../scripts/uav_figures.py"
+
+
+rule uav_recording:
+    output:
+        "results/recordings/uav_run{k}.rrd",
+    log:
+        "results/logs/uav_recording/run{k}.log",
+    benchmark:
+        "results/benchmarks/uav_recording/run{k}.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        uav=pick(UAV, *UAV_MODEL_KEYS),
+        methods=[dataclasses.asdict(s) for s in UAV_SPECS.values()],
+        max_hypotheses=UAV["recording"]["max_hypotheses"],
+        seed=config["seed"],
+    script:
+        "../scripts/uav_recording.py"
+
+
+rule uav:
+    input:
+        rules.uav_collect.output,
+        rules.uav_summary.output,
+        rules.uav_figures.output,
+        expand("results/recordings/uav_run{k}.rrd", k=UAV_RECORDED),
