@@ -182,3 +182,37 @@ def test_nbo_estimate_is_the_zero_noise_trajectory():
     u = np.array([0.55, 0.17])
     expected = lqg.nbo_cost(u, x0=0.0, a=0.5, r=10.0, target=1.0)
     assert nbo_estimate(model, [0.0], u) == pytest.approx(expected, rel=1e-13)
+
+
+def test_level_noise_gives_each_level_its_own_distribution():
+    first, later = GaussianNoise(np.diag([4.0, 1.0])), GaussianNoise(np.diag([0.01, 0.09]))
+
+    class Walk:
+        noise = later
+
+        def step(self, x, u_k, w):
+            return x + w
+
+        def stage_cost(self, x, u_k):
+            return np.zeros(x.shape[0])
+
+        def terminal_cost(self, x):
+            return np.zeros(x.shape[0])
+
+    tree = sample_tree(
+        Walk(),
+        [0.0, 0.0],
+        [0, 1, 2],
+        3,
+        np.random.default_rng(5),
+        level_noise=[first, later, later],
+    )
+    replay = np.random.default_rng(5)
+    expected = [first.sample(replay, 3), later.sample(replay, 3), later.sample(replay, 3)]
+    w = tree.leaves.noise
+    for k in range(3):
+        np.testing.assert_allclose(np.unique(w[:, k, 0]), np.sort(expected[k][:, 0]))
+    ll = first.logpdf(w[:, 0]) + later.logpdf(w[:, 1]) + later.logpdf(w[:, 2])
+    np.testing.assert_allclose(tree.leaves.log_likeliness, ll, rtol=1e-12)
+    with pytest.raises(ValueError, match="one noise model per level"):
+        sample_tree(Walk(), [0.0, 0.0], [0, 1], 3, np.random.default_rng(5), level_noise=[first])

@@ -23,6 +23,7 @@ i.i.d. Gaussian noise :math:`w_k \sim \mathcal N(0, \Sigma)`. A trajectory there
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Protocol
 
@@ -219,6 +220,7 @@ def sample_tree(
     max_keep: int | None = None,
     shared_draws: bool = True,
     keep_history: bool = False,
+    level_noise: Sequence[GaussianNoise] | None = None,
 ) -> TreeSample:
     """Tree sampling with ``N = n_branch`` draws per step (Fig. 1a), optionally pruned to ``M``.
 
@@ -231,6 +233,9 @@ def sample_tree(
     shared_draws : the paper's tree (same ``N`` noise values for every node of a level) if True,
         otherwise every node draws its own ``N`` children.
     keep_history : record every level before pruning (for recordings/diagnostics).
+    level_noise : optional noise model of every level (length H), e.g. an initial-state
+        level with its own covariance; default ``system.noise`` at every level. The noise
+        paths in the result then need a common dimension.
     """
     u = _controls(u)
     if n_branch < 1:
@@ -243,7 +248,12 @@ def sample_tree(
             f"an unpruned tree with N={n_branch}, H={horizon} has {n_branch**horizon} leaves; "
             "set M (pruning) or reduce N/H"
         )
-    noise = system.noise
+    levels = [system.noise] * u.shape[0] if level_noise is None else list(level_noise)
+    if len(levels) != u.shape[0]:
+        raise ValueError(
+            f"level_noise needs one noise model per level ({u.shape[0]}), got {len(levels)}"
+        )
+    noise = levels[0]
     x = np.atleast_1d(np.asarray(x0, dtype=float))[None, :]
     paths = x[:, None, :]  # (n, k+1, dx)
     w_paths = np.empty((1, 0, noise.dim))
@@ -251,6 +261,7 @@ def sample_tree(
     cost = np.zeros(1)
     history: list[TreeLevel] = []
     for k in range(horizon):
+        noise = levels[k]
         n_nodes = x.shape[0]
         if shared_draws:
             w_new = noise.sample(rng, n_branch)  # (N, dw)

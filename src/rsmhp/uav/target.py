@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 from rsmhp.sampling import GaussianNoise, top_m
+from rsmhp.sampling import sample_tree as _sample_tree
 
 __all__ = [
     "TargetModel",
@@ -121,6 +122,29 @@ def sample_independent(
     return _propagate(x0, w, model.F)
 
 
+@dataclass(frozen=True)
+class _Hypotheses:
+    r"""Target hypotheses as a :class:`rsmhp.sampling.System` for the shared tree sampler.
+
+    Level 0 (control index ``u_0 = 0``) draws the current state: :math:`x = \hat x + w_0`,
+    :math:`w_0 \sim \mathcal N(0, \hat P)`; levels ``j >= 1`` propagate :math:`x \leftarrow
+    F x + w_j`, :math:`w_j \sim \mathcal N(0, Q)`. Costs are zero (the planner evaluates
+    hypotheses with its own kernel).
+    """
+
+    F: np.ndarray
+    noise: GaussianNoise
+
+    def step(self, x: np.ndarray, u_k: float, w: np.ndarray) -> np.ndarray:
+        return x + w if u_k == 0 else x @ self.F.T + w
+
+    def stage_cost(self, x: np.ndarray, u_k: float) -> np.ndarray:
+        return np.zeros(x.shape[0])
+
+    def terminal_cost(self, x: np.ndarray) -> np.ndarray:
+        return np.zeros(x.shape[0])
+
+
 def sample_tree(
     x_hat: np.ndarray,
     P_hat: np.ndarray,
@@ -130,32 +154,26 @@ def sample_tree(
     model: TargetModel,
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Pruned tree of hypotheses: ``(states (m, H, 4), log_likeliness (m,))``, ``m <= M``.
+    r"""Pruned tree of hypotheses: ``(states (m, H, 4), log_likeliness (m,))``, ``m <= M``.
 
-    Level 0: ``N`` initial states from :math:`\\mathcal N(\\hat x, \\hat P)` (pruned to M if
-    ``N > M``). Level ``j = 1..H``: ``N`` noise values :math:`w_j^b \\sim \\mathcal N(0, Q)`
-    shared by the level; each surviving node ``i`` spawns children
-    :math:`F x^i + w_j^b`; keep the ``M`` children with the largest summed log-density
-    (ties by index, :func:`rsmhp.sampling.top_m`). Survivors are sorted by decreasing
-    likeliness.
+    :func:`rsmhp.sampling.sample_tree` with ``H + 1`` levels (paper Fig. 1a, shared draws):
+    level 0 draws ``N`` initial states from :math:`\mathcal N(\hat x, \hat P)`, levels
+    ``1..H`` draw ``N`` process-noise values :math:`w \sim \mathcal N(0, Q)` shared by all
+    nodes; after every level the ``M`` most likely trajectories are kept. Survivors are
+    returned sorted by decreasing likeliness (ties by tree order).
     """
-    init = GaussianNoise(0.5 * (P_hat + P_hat.T))
     noise = GaussianNoise(model.Q)
-    d0 = init.sample(rng, n_branch)
-    loglik = init.logpdf(d0)
-    keep = top_m(loglik, max_keep)
-    x = np.asarray(x_hat, dtype=float) + d0[keep]
-    loglik = loglik[keep]
-    paths = np.empty((len(keep), 0, 4))
-    F = model.F
-    for _ in range(horizon):
-        w = noise.sample(rng, n_branch)  # shared by every node of this level
-        lw = noise.logpdf(w)
-        child = (x @ F.T)[:, None, :] + w[None, :, :]  # (nodes, N, 4)
-        child_ll = (loglik[:, None] + lw[None, :]).ravel()
-        parent = np.repeat(np.arange(len(x)), n_branch)
-        keep = top_m(child_ll, max_keep)
-        x = child.reshape(-1, 4)[keep]
-        paths = np.concatenate([paths[parent[keep]], x[:, None, :]], axis=1)
-        loglik = child_ll[keep]
-    return paths, loglik
+    system = _Hypotheses(F=model.F, noise=noise)
+    levels = [GaussianNoise(0.5 * (P_hat + P_hat.T))] + [noise] * horizon
+    tree = _sample_tree(
+        system,
+        np.asarray(x_hat, dtype=float),
+        np.arange(horizon + 1),
+        n_branch,
+        rng,
+        max_keep=max_keep,
+        level_noise=levels,
+    )
+    order = top_m(tree.leaves.log_likeliness, len(tree.leaves))
+    # states[:, 0] is x_hat, states[:, 1] the drawn current state, then H steps ahead
+    return tree.leaves.states[order, 2:], tree.leaves.log_likeliness[order]
