@@ -7,7 +7,7 @@ import pandas as pd
 import seaborn as sns
 
 from rsmhp.analysis.uav import method_label
-from rsmhp.figures import theme
+from rsmhp.figures import seeded_legacy_random, theme
 
 __all__ = ["error_cdf_nbo_figure", "error_cdf_nt_figure", "paired_diff_figure"]
 
@@ -61,7 +61,8 @@ def paired_diff_figure(
     )
     order = [labels[m] for m in vs["method"]]
     fig, ax = plt.subplots(figsize=(6.5, 0.9 + 0.8 * len(order)))
-    sns.stripplot(data=long, x="diff", y="label", order=order, ax=ax, alpha=0.35, size=3)
+    with seeded_legacy_random("uav_paired_diff"):  # seaborn's jitter uses np.random
+        sns.stripplot(data=long, x="diff", y="label", order=order, ax=ax, alpha=0.35, size=3)
     for i, (_, r) in enumerate(vs.iterrows()):
         ax.errorbar(
             r["mean_diff"],
