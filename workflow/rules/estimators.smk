@@ -119,8 +119,9 @@ rule estimators_recording:
         model=canonical(config["lqg"]["model"]),
         recording=canonical(config["estimators"]["recording"]),
         seed=config["seed"],
+        experiment="estimators_recording",
     script:
-        "../scripts/estimators_recording.py"
+        "../scripts/tree_recording.py"
 
 
 rule estimators:

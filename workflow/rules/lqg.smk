@@ -117,8 +117,9 @@ rule lqg_recording:
         model=canonical(config["lqg"]["model"]),
         recording=canonical(config["lqg"]["recording"]),
         seed=config["seed"],
+        experiment="lqg_recording",
     script:
-        "../scripts/lqg_recording.py"
+        "../scripts/tree_recording.py"
 
 
 rule lqg:

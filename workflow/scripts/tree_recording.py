@@ -1,4 +1,4 @@
-"""Rule lqg_recording: a small pruned tree, step by step, as a rerun recording."""
+"""Rules lqg_recording, estimators_recording: one LQG tree, step by step, as a rerun recording."""
 
 from rsmhp.experiments.lqg import LQGParams
 from rsmhp.pipeline import rule_logging
@@ -13,5 +13,6 @@ with rule_logging(snakemake.log[0], snakemake.rule) as log:
         n_branch=rec["N"],
         max_keep=rec["M"],
         seed=snakemake.params.seed,
+        experiment=snakemake.params.experiment,
     )
     log.info("logged %d entities, %d rows", len(rows), sum(rows.values()))
