@@ -86,12 +86,6 @@ def _cross_field(config: Mapping[str, Any]) -> list[str]:
             f"lqg.convergence.P.start: {grid['start']} is greater than lqg.convergence.P.stop "
             f"= {grid['stop']} (allowed: start <= stop)"
         )
-    rec = lqg.get("recording", {}) or {}
-    if {"N", "M"} <= rec.keys() and rec["M"] > rec["N"]:
-        problems.append(
-            f"lqg.recording.M: {rec['M']} is greater than lqg.recording.N = {rec['N']} "
-            f"(allowed: 1 <= M <= N; the paper prunes to M <= N trajectories)"
-        )
     est = config.get("estimators", {}) or {}
     problems.extend(_estimator_problems(est.get("problems", []) or []))
     for n in est.get("budgets", []) or []:
@@ -105,12 +99,13 @@ def _cross_field(config: Mapping[str, Any]) -> list[str]:
             f"estimators.pruning.M: every M ({min(pr['M'])} and up) is greater than every N "
             f"(at most {max(pr['N'])}) (allowed: M <= N for at least one pair)"
         )
-    erec = est.get("recording", {}) or {}
-    if {"N", "M"} <= erec.keys() and erec["M"] > erec["N"]:
-        problems.append(
-            f"estimators.recording.M: {erec['M']} is greater than estimators.recording.N = "
-            f"{erec['N']} (allowed: 1 <= M <= N)"
-        )
+    for section in ("lqg", "estimators"):
+        rec = (config.get(section, {}) or {}).get("recording", {}) or {}
+        if {"N", "M"} <= rec.keys() and rec["M"] > rec["N"]:
+            problems.append(
+                f"{section}.recording.M: {rec['M']} is greater than {section}.recording.N = "
+                f"{rec['N']} (allowed: 1 <= M <= N; the paper prunes to M <= N trajectories)"
+            )
     for key in ("x0", "r", "target", "sigma", "a"):
         val = (lqg.get("model", {}) or {}).get(key)
         if isinstance(val, float) and not math.isfinite(val):
