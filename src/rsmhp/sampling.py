@@ -62,6 +62,11 @@ class GaussianNoise:
         self._log_norm = -0.5 * (self.dim * np.log(2 * np.pi)) - np.sum(np.log(np.diag(self._chol)))
 
     @property
+    def chol(self) -> np.ndarray:
+        r"""Lower Cholesky factor :math:`L`, :math:`L L^\top = \Sigma`, shape (d, d)."""
+        return self._chol
+
+    @property
     def mean(self) -> np.ndarray:
         """The nominal noise value used by NBO, :math:`\\bar w = 0`, shape (d,)."""
         return np.zeros(self.dim)

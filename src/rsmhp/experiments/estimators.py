@@ -148,7 +148,7 @@ def grid_points(cfg: Mapping[str, Any], problems: Mapping[str, LinearQuadratic])
 
 def _sample(point: GridPoint, prob: LinearQuadratic, rng: np.random.Generator | None):
     """Returns (cost, log_likeliness or None, quadrature weights or None, n_nodes)."""
-    chol = np.linalg.cholesky(prob.Sigma)
+    chol = prob.noise.chol  # factorized once per problem (cached GaussianNoise)
     H = prob.H
     s = point.scheme
     if s == "mc":
