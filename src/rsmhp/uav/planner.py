@@ -8,12 +8,12 @@ Decision variable: normalised controls :math:`x \in [-1, 1]^{2H}`, mapped to
 for fixed target hypotheses (NBO: the single nominal one; RS-MHP: N_T samples drawn once per
 planning step, i.e. common random numbers across every evaluation of the optimisation).
 
-Gradient: forward differences :math:`(J(x + h e_l) - J(x))/h` for :math:`l = 1..2H`, with
-:math:`-h` where :math:`x_l + h` would leave the box. The base point and the 2H perturbed
-sequences (13 for H = 6) are evaluated in **one** kernel call. The optimiser is scipy's
-L-BFGS-B with the box as bounds, ``maxiter`` iterations and ``maxfun`` evaluations at most
-(identical for every method), started from the warm start (the previous plan shifted by one
-step, last control repeated; zeros at the first step).
+Value and exact gradient :math:`\nabla_x J` come from one call of the compiled kernel
+:func:`rsmhp.uav.fused.cost_and_grad` (adjoint of the covariance recursion and of the
+kinematics; no finite differences). The optimiser is scipy's L-BFGS-B with the box as bounds,
+``maxiter`` iterations and ``maxfun`` evaluations at most (identical for every method),
+started from the warm start (the previous plan shifted by one step, last control repeated;
+zeros at the first step).
 """
 
 from __future__ import annotations
@@ -25,8 +25,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import minimize
 
-from rsmhp.uav import kinematics
-from rsmhp.uav.kernel import objective
+from rsmhp.uav import fused, kinematics
 from rsmhp.uav.kinematics import UAVParams
 from rsmhp.uav.sensor import SensorModel
 from rsmhp.uav.target import TargetModel
@@ -36,12 +35,11 @@ __all__ = ["PlanResult", "PlannerParams", "PlanningProblem", "plan", "shift_plan
 
 @dataclass(frozen=True)
 class PlannerParams:
-    """Horizon ``H``, optimiser budget and forward-difference step (normalised units)."""
+    """Horizon ``H`` and optimiser budget (L-BFGS-B iterations and objective evaluations)."""
 
     horizon: int
     maxiter: int
     maxfun: int
-    fd_step: float
 
     @classmethod
     def from_config(cls, uav: Mapping[str, Any]) -> PlannerParams:
@@ -50,7 +48,6 @@ class PlannerParams:
             horizon=int(p["horizon"]),
             maxiter=int(p["maxiter"]),
             maxfun=int(p["maxfun"]),
-            fd_step=float(p["fd_step"]),
         )
 
 
@@ -69,8 +66,8 @@ class PlanResult:
 class PlanningProblem:
     """The objective of one planning step with its hypotheses held fixed.
 
-    ``value_and_grad(x)`` evaluates the base point and its 2H forward-difference
-    neighbours in one kernel call and returns ``(J(x), grad J(x))``; the last result is cached.
+    ``value_and_grad(x)`` returns ``(J(x), grad J(x))`` from one compiled kernel call; the
+    last result is cached. ``costs(xs)`` evaluates a batch of sequences (values only).
     """
 
     def __init__(
@@ -90,6 +87,9 @@ class PlanningProblem:
         self.scale = np.tile(uav.control_scale, params.horizon)
         self.n_kernel_calls = 0
         self._cache: tuple[np.ndarray, float, np.ndarray] | None = None
+        self._frozen = fused.Frozen(
+            self.uav_state, uav, self.P_hat, self.target_xy, target.dt, target.Q, sensor
+        )
 
     def controls(self, x: np.ndarray) -> np.ndarray:
         """Normalised ``x`` (..., 2H) -> controls (..., H, 2)."""
@@ -98,23 +98,19 @@ class PlanningProblem:
 
     def costs(self, xs: np.ndarray) -> np.ndarray:
         """Costs of a batch of normalised sequences ``xs`` (C, 2H) -> (C,), one kernel call."""
-        states = kinematics.rollout(self.uav_state, self.controls(xs), self.uav)
         self.n_kernel_calls += 1
-        return objective(
-            self.P_hat, states[..., :2], self.target_xy, self.target.dt, self.target.Q, self.sensor
-        )
+        return fused.evaluate(np.atleast_2d(xs), self._frozen, want_grad=False)[0]
 
     def value_and_grad(self, x: np.ndarray) -> tuple[float, np.ndarray]:
+        """``(J(x), grad J(x))`` for one normalised sequence ``x`` (2H,)."""
         x = np.asarray(x, dtype=float)
         if self._cache is not None and np.array_equal(self._cache[0], x):
             return self._cache[1], self._cache[2].copy()
-        h = self.params.fd_step
-        steps = np.where(x + h <= 1.0, h, -h)
-        batch = np.vstack([x, x + np.diag(steps)])
-        c = self.costs(batch)
-        grad = (c[1:] - c[0]) / steps
-        self._cache = (x.copy(), float(c[0]), grad)
-        return float(c[0]), grad.copy()
+        self.n_kernel_calls += 1
+        c, g = fused.evaluate(x.reshape(1, -1), self._frozen, want_grad=True)
+        f, grad = float(c[0]), g[0]
+        self._cache = (x.copy(), f, grad)
+        return f, grad.copy()
 
 
 def shift_plan(controls: np.ndarray) -> np.ndarray:

@@ -43,6 +43,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from threadpoolctl import threadpool_limits
 
 from rsmhp.seeding import job_rng
 from rsmhp.uav import kinematics, sensor, target
@@ -186,7 +187,16 @@ def simulate_run(
     run: int,
     observer: Callable[[StepInfo], None] | None = None,
 ) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """Simulate run ``run`` with ``method``: (summary row, per-step rows)."""
+    """Simulate run ``run`` with ``method``: (summary row, per-step rows).
+
+    BLAS is limited to one thread for the run: the planner's small dense algebra (scipy's
+    L-BFGS-B on 2H variables) is many times slower with a multi-threaded BLAS pool.
+    """
+    with threadpool_limits(limits=1):
+        return _simulate_run(setup, method, seed, run, observer)
+
+
+def _simulate_run(setup, method, seed, run, observer):
     sc = draw_scenario(setup, seed, run)
     K, H = setup.steps, setup.planner.horizon
     w = job_rng(seed, "uav_process_noise", run=run).standard_normal((K, 4))

@@ -1,0 +1,452 @@
+r"""Compiled planner kernel: cost of C control sequences and its exact gradient in one pass.
+
+For normalised controls :math:`x \in [-1, 1]^{2H}` (rows of ``x`` (C, 2H)), the UAV state
+:math:`s_0` (4,) and ``T`` target hypotheses ``target_xy`` (T, H, 2) this computes
+
+.. math::
+    J(x) = \frac1T \sum_{i=1}^{T} \sum_{j=1}^{H} \mathrm{tr}\, P_j^{i}(x)
+
+exactly as :func:`rsmhp.uav.kinematics.rollout` followed by :func:`rsmhp.uav.kernel.objective`
+(the numpy kernel, kept as this module's test oracle), and optionally :math:`\nabla_x J`
+(C, 2H), in a single compiled loop without temporaries.
+
+Forward pass. Controls :math:`u_j = (a_{\max} x_{2j}, \phi_{\max} x_{2j+1})` drive the
+kinematics of :mod:`rsmhp.uav.kinematics`; the UAV positions :math:`q_j` (j = 1..H) set
+:math:`R_j = R(q_j, t^i_j)` (:mod:`rsmhp.uav.sensor`) in the covariance recursion of
+:mod:`rsmhp.uav.kernel` (same block formulas, same operation order).
+
+Reverse pass (adjoint of the covariance recursion). With gain :math:`K = P^- H^T S^{-1}` and
+:math:`E = I - KH`, the first-order change of one update is
+:math:`dP^+ = E\, dP^-\, E^T + K\, dR\, K^T` (the optimal-gain identity), and the prediction
+:math:`P^- = F P F^T + Q` gives :math:`dP^- = F\, dP\, F^T`. So with :math:`G_j = \partial J /
+\partial P_j` (symmetric 4x4, starting from :math:`G_H = I`):
+
+.. math::
+    \bar R_j = K_j^T G_j K_j, \qquad G^-_j = E_j^T G_j E_j, \qquad
+    G_{j-1} = F^T G^-_j F + I .
+
+In 2x2 blocks, :math:`K = [M^T; N^T]` with :math:`M = S^{-1}A^-`, :math:`N = S^{-1}B^-` (the
+quantities the forward pass already forms), so nothing but 8 numbers per step is stored.
+
+Sensor geometry. With :math:`v = t - q` (target minus UAV, horizontal), :math:`\rho^2 = |v|^2`,
+:math:`d^2 = \rho^2 + h^2` and :math:`D = f_r^2 - f_c^2`,
+:math:`R = f_c^2 d^2 I + D\,(1 + h^2/\rho^2)\, v v^T`, hence for
+:math:`L = \langle \bar R, R\rangle`, :math:`\bar q = v^T \bar R v`:
+
+.. math::
+    \frac{\partial L}{\partial v} = 2 f_c^2\, \mathrm{tr}(\bar R)\, v
+    + 2D\Big(1 + \frac{h^2}{\rho^2}\Big) \bar R v - \frac{2 D h^2 \bar q}{\rho^4}\, v,
+    \qquad \frac{\partial L}{\partial q} = -\frac{\partial L}{\partial v}.
+
+Directly overhead (:math:`\rho = 0`) the bearing is undefined: the value uses
+:math:`\beta = 0` (as the numpy kernel does) and R is discontinuous there, so no derivative
+exists; we return the derivative with the bearing frozen, which is :math:`0` (the
+:math:`v`-terms vanish at :math:`v = 0`). Near (not at) overhead the derivative is exact but
+grows like :math:`h^2 \|\bar R\| / \rho`.
+
+Kinematics adjoint (state :math:`(p_x, p_y, s, \psi)`, step :math:`s' =
+\mathrm{clip}(s + a\Delta t)`, :math:`\psi' = \psi + g \tan\phi/s\,\Delta t`, :math:`p' = p +
+s'\Delta t (\cos\psi', \sin\psi')`): back-substitution of these three lines. At a clip the
+speed derivative is taken as 0 when :math:`s + a\Delta t` lies on or outside the speed
+bounds (a one-sided derivative; the clip has a kink there).
+
+Compilation: numba ``njit`` with ``cache=True``; the first call on a machine compiles (a few
+seconds) and writes the cache beside this file, or in numba's user-wide cache directory when
+the install is read-only (or in ``NUMBA_CACHE_DIR`` when set); later processes load it.
+Single-threaded: parallelism is across closed-loop runs (joblib), never inside the kernel.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+from rsmhp.uav.kinematics import UAVParams
+from rsmhp.uav.sensor import SensorModel
+
+__all__ = ["Frozen", "cost", "cost_and_grad", "covariance_traces", "evaluate", "warm_up"]
+
+
+# --------------------------------------------------------------------------------------------
+# compiled building blocks (inlined by LLVM; tuples of scalars, no heap allocation)
+
+
+@njit(cache=True, inline="always")
+def _meas_cov(ux, uy, tx, ty, fr2, fc2, h2):  # pragma: no cover - compiled
+    """(R_xx, R_xy, R_yy): same operation order as rsmhp.uav.sensor.measurement_cov_entries."""
+    dx = tx - ux
+    dy = ty - uy
+    rho2 = dx * dx + dy * dy
+    if rho2 == 0.0:
+        c, s = 1.0, 0.0
+    else:
+        rho = np.sqrt(rho2)
+        c, s = dx / rho, dy / rho
+    d2 = rho2 + h2
+    rxx = d2 * (fr2 * c * c + fc2 * s * s)
+    rxy = d2 * (fr2 - fc2) * c * s
+    ryy = d2 * (fr2 * s * s + fc2 * c * c)
+    return rxx, rxy, ryy
+
+
+@njit(cache=True, inline="always")
+def _kalman_step(p, rxx, rxy, ryy, dt, q):  # pragma: no cover - compiled
+    """One predict + update of the 10 distinct entries ``p`` of P (order a11, a12, a22, b11,
+    b12, b21, b22, c11, c12, c22; ``q`` likewise for Q). Returns (P+, M, N) with M = S^-1 A^-,
+    N = S^-1 B^- as 4-tuples (row-major). Same arithmetic as rsmhp.uav.kernel."""
+    a11, a12, a22, b11, b12, b21, b22, c11, c12, c22 = p
+    dt2 = dt * dt
+    pa11 = a11 + 2 * dt * b11 + dt2 * c11 + q[0]
+    pa12 = a12 + dt * (b12 + b21) + dt2 * c12 + q[1]
+    pa22 = a22 + 2 * dt * b22 + dt2 * c22 + q[2]
+    pb11 = b11 + dt * c11 + q[3]
+    pb12 = b12 + dt * c12 + q[4]
+    pb21 = b21 + dt * c12 + q[5]
+    pb22 = b22 + dt * c22 + q[6]
+    pc11, pc12, pc22 = c11 + q[7], c12 + q[8], c22 + q[9]
+    s11 = pa11 + rxx
+    s12 = pa12 + rxy
+    s22 = pa22 + ryy
+    inv_det = 1.0 / (s11 * s22 - s12 * s12)
+    i11, i12, i22 = s22 * inv_det, -s12 * inv_det, s11 * inv_det
+    m11 = i11 * pa11 + i12 * pa12
+    m12 = i11 * pa12 + i12 * pa22
+    m21 = i12 * pa11 + i22 * pa12
+    m22 = i12 * pa12 + i22 * pa22
+    n11 = i11 * pb11 + i12 * pb21
+    n12 = i11 * pb12 + i12 * pb22
+    n21 = i12 * pb11 + i22 * pb21
+    n22 = i12 * pb12 + i22 * pb22
+    out = (
+        pa11 - (pa11 * m11 + pa12 * m21),
+        pa12 - (pa11 * m12 + pa12 * m22),
+        pa22 - (pa12 * m12 + pa22 * m22),
+        pb11 - (pa11 * n11 + pa12 * n21),
+        pb12 - (pa11 * n12 + pa12 * n22),
+        pb21 - (pa12 * n11 + pa22 * n21),
+        pb22 - (pa12 * n12 + pa22 * n22),
+        pc11 - (pb11 * n11 + pb21 * n21),
+        pc12 - (pb11 * n12 + pb21 * n22),
+        pc22 - (pb12 * n12 + pb22 * n22),
+    )
+    return out, (m11, m12, m21, m22), (n11, n12, n21, n22)
+
+
+@njit(cache=True, inline="always")
+def _mm(a, b):  # pragma: no cover - compiled
+    """2x2 product of row-major 4-tuples."""
+    return (
+        a[0] * b[0] + a[1] * b[2],
+        a[0] * b[1] + a[1] * b[3],
+        a[2] * b[0] + a[3] * b[2],
+        a[2] * b[1] + a[3] * b[3],
+    )
+
+
+@njit(cache=True, inline="always")
+def _mmt(a, b):  # pragma: no cover - compiled
+    """a @ b.T for row-major 2x2 4-tuples."""
+    return (
+        a[0] * b[0] + a[1] * b[1],
+        a[0] * b[2] + a[1] * b[3],
+        a[2] * b[0] + a[3] * b[1],
+        a[2] * b[2] + a[3] * b[3],
+    )
+
+
+@njit(cache=True, inline="always")
+def _sub(a, b):  # pragma: no cover - compiled
+    return (a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3])
+
+
+@njit(cache=True, inline="always")
+def _add(a, b):  # pragma: no cover - compiled
+    return (a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3])
+
+
+@njit(cache=True, inline="always")
+def _adjoint_step(ga, gb, gc, m, n, dt):  # pragma: no cover - compiled
+    r"""Given G = [[Ga, Gb], [Gb^T, Gc]] = dJ/dP^+ (2x2 blocks as row-major 4-tuples), return
+    (Rbar = K^T G K, and the blocks of F^T (E^T G E) F), with K = [M^T; N^T], E = I - K H."""
+    mga = _mm(m, ga)
+    mgb = _mm(m, gb)
+    ngc = _mm(n, gc)
+    # Rbar = M Ga M^T + M Gb N^T + N Gb^T M^T + N Gc N^T
+    t1 = _mmt(mga, m)
+    t2 = _mmt(mgb, n)
+    t4 = _mmt(ngc, n)
+    rbar = (
+        t1[0] + 2.0 * t2[0] + t4[0],
+        t1[1] + t2[1] + t2[2] + t4[1],
+        t1[2] + t2[2] + t2[1] + t4[2],
+        t1[3] + 2.0 * t2[3] + t4[3],
+    )
+    # E^T G E with W = I - M: TL = W X - N Y, X = Ga W^T - Gb N^T, Y = Gb^T W^T - Gc N^T,
+    # TR = W Gb - N Gc, BR = Gc
+    w = (1.0 - m[0], -m[1], -m[2], 1.0 - m[3])
+    gbt = (gb[0], gb[2], gb[1], gb[3])
+    x = _sub(_mmt(ga, w), _mmt(gb, n))
+    y = _sub(_mmt(gbt, w), _mmt(gc, n))
+    tl = _sub(_mm(w, x), _mm(n, y))
+    tr = _sub(_mm(w, gb), ngc)
+    # symmetrise TL (it is symmetric in exact arithmetic)
+    tl_s = 0.5 * (tl[1] + tl[2])
+    tl = (tl[0], tl_s, tl_s, tl[3])
+    # F^T G^- F: Ga' = Ga, Gb' = dt Ga + Gb, Gc' = dt^2 Ga + dt (Gb + Gb^T) + Gc
+    ga2 = tl
+    gb2 = (dt * tl[0] + tr[0], dt * tl[1] + tr[1], dt * tl[2] + tr[2], dt * tl[3] + tr[3])
+    dt2 = dt * dt
+    gc2 = (
+        dt2 * tl[0] + dt * 2.0 * tr[0] + gc[0],
+        dt2 * tl[1] + dt * (tr[1] + tr[2]) + gc[1],
+        dt2 * tl[2] + dt * (tr[2] + tr[1]) + gc[2],
+        dt2 * tl[3] + dt * 2.0 * tr[3] + gc[3],
+    )
+    return rbar, ga2, gb2, gc2
+
+
+@njit(cache=True, inline="always")
+def _meas_cov_grad(ux, uy, tx, ty, rbar, fr2, fc2, h2):  # pragma: no cover - compiled
+    """d<Rbar, R>/d(uav x, uav y) (see module docstring); 0 directly overhead."""
+    dx = tx - ux
+    dy = ty - uy
+    rho2 = dx * dx + dy * dy
+    if rho2 == 0.0:
+        return 0.0, 0.0
+    dd = fr2 - fc2
+    rv0 = rbar[0] * dx + rbar[1] * dy
+    rv1 = rbar[2] * dx + rbar[3] * dy
+    qb = dx * rv0 + dy * rv1
+    tr = rbar[0] + rbar[3]
+    k1 = 2.0 * fc2 * tr - 2.0 * dd * h2 * qb / (rho2 * rho2)
+    k2 = 2.0 * dd * (1.0 + h2 / rho2)
+    gvx = k1 * dx + k2 * rv0
+    gvy = k1 * dy + k2 * rv1
+    return -gvx, -gvy
+
+
+@njit(cache=True, nogil=True)
+def _cost_grad_kernel(
+    x, state0, scale, uav_dt, g, smin, smax, p0, txy, tdt, q, fr2, fc2, h2, want_grad, cost, grad
+):  # pragma: no cover - compiled
+    n_c = x.shape[0]
+    horizon = x.shape[1] // 2
+    n_t = txy.shape[0]
+    uxy = np.empty((horizon, 2))
+    spd = np.empty(horizon + 1)
+    hdg = np.empty(horizon + 1)
+    inside = np.empty(horizon, dtype=np.bool_)
+    mn = np.empty((horizon, 8))
+    gxy = np.empty((horizon, 2))
+    amax, phimax = scale[0], scale[1]
+    for c in range(n_c):
+        # ---- kinematics (rsmhp.uav.kinematics.step, same operation order)
+        px, py = state0[0], state0[1]
+        spd[0], hdg[0] = state0[2], state0[3]
+        for j in range(horizon):
+            a = min(max(x[c, 2 * j] * amax, -amax), amax)
+            phi = min(max(x[c, 2 * j + 1] * phimax, -phimax), phimax)
+            v = spd[j] + a * uav_dt
+            inside[j] = smin < v < smax
+            s_new = min(max(v, smin), smax)
+            h_new = hdg[j] + g * np.tan(phi) / spd[j] * uav_dt
+            px = px + s_new * uav_dt * np.cos(h_new)
+            py = py + s_new * uav_dt * np.sin(h_new)
+            spd[j + 1], hdg[j + 1] = s_new, h_new
+            uxy[j, 0], uxy[j, 1] = px, py
+        # ---- covariance recursion per hypothesis, and its adjoint
+        total = 0.0
+        for j in range(horizon):
+            gxy[j, 0] = 0.0
+            gxy[j, 1] = 0.0
+        for i in range(n_t):
+            p = p0
+            acc = 0.0
+            for j in range(horizon):
+                rxx, rxy, ryy = _meas_cov(
+                    uxy[j, 0], uxy[j, 1], txy[i, j, 0], txy[i, j, 1], fr2, fc2, h2
+                )
+                p, m, n = _kalman_step(p, rxx, rxy, ryy, tdt, q)
+                acc += p[0] + p[2] + p[7] + p[9]
+                if want_grad:
+                    mn[j, 0], mn[j, 1], mn[j, 2], mn[j, 3] = m
+                    mn[j, 4], mn[j, 5], mn[j, 6], mn[j, 7] = n
+            total += acc
+            if want_grad:
+                ga = (1.0, 0.0, 0.0, 1.0)
+                gb = (0.0, 0.0, 0.0, 0.0)
+                gc = (1.0, 0.0, 0.0, 1.0)
+                for j in range(horizon - 1, -1, -1):
+                    m = (mn[j, 0], mn[j, 1], mn[j, 2], mn[j, 3])
+                    n = (mn[j, 4], mn[j, 5], mn[j, 6], mn[j, 7])
+                    rbar, ga, gb, gc = _adjoint_step(ga, gb, gc, m, n, tdt)
+                    ga = (ga[0] + 1.0, ga[1], ga[2], ga[3] + 1.0)
+                    gc = (gc[0] + 1.0, gc[1], gc[2], gc[3] + 1.0)
+                    gx, gy = _meas_cov_grad(
+                        uxy[j, 0], uxy[j, 1], txy[i, j, 0], txy[i, j, 1], rbar, fr2, fc2, h2
+                    )
+                    gxy[j, 0] += gx
+                    gxy[j, 1] += gy
+        cost[c] = total / n_t
+        if not want_grad:
+            continue
+        # ---- kinematics adjoint: (bpx, bpy, bs, bpsi) = dJ/d(state after step j)
+        bpx = bpy = bs = bpsi = 0.0
+        for j in range(horizon - 1, -1, -1):
+            bpx += gxy[j, 0] / n_t
+            bpy += gxy[j, 1] / n_t
+            s_new, h_new = spd[j + 1], hdg[j + 1]
+            ch, sh = np.cos(h_new), np.sin(h_new)
+            bs_new = bs + uav_dt * (bpx * ch + bpy * sh)
+            bpsi_new = bpsi + s_new * uav_dt * (bpy * ch - bpx * sh)
+            phi = min(max(x[c, 2 * j + 1] * phimax, -phimax), phimax)
+            cphi = np.cos(phi)
+            bphi = bpsi_new * g * uav_dt / (spd[j] * cphi * cphi)
+            bs = -bpsi_new * g * np.tan(phi) * uav_dt / (spd[j] * spd[j])
+            bpsi = bpsi_new
+            ba = 0.0
+            if inside[j]:
+                bs += bs_new
+                ba = bs_new * uav_dt
+            grad[c, 2 * j] = ba * amax
+            grad[c, 2 * j + 1] = bphi * phimax
+    return cost, grad
+
+
+@njit(cache=True, nogil=True)
+def _traces_kernel(p0, uxy, txy, tdt, q, fr2, fc2, h2, out):  # pragma: no cover - compiled
+    for c in range(uxy.shape[0]):
+        for i in range(txy.shape[0]):
+            p = p0
+            for j in range(uxy.shape[1]):
+                rxx, rxy, ryy = _meas_cov(
+                    uxy[c, j, 0], uxy[c, j, 1], txy[i, j, 0], txy[i, j, 1], fr2, fc2, h2
+                )
+                p, _m, _n = _kalman_step(p, rxx, rxy, ryy, tdt, q)
+                out[c, i, j] = p[0] + p[2] + p[7] + p[9]
+    return out
+
+
+# --------------------------------------------------------------------------------------------
+# Python entry points
+
+
+def _entries(P: np.ndarray) -> tuple[float, ...]:
+    """The 10 distinct entries of a symmetric 4x4 matrix, in the kernel's order."""
+    P = 0.5 * (P + P.T)
+    idx = ((0, 0), (0, 1), (1, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 2), (2, 3), (3, 3))
+    return tuple(float(P[r, c]) for r, c in idx)
+
+
+def _sensor_args(sensor: SensorModel) -> tuple[float, float, float]:
+    return sensor.sigma_r_per_m**2, sensor.sigma_c_per_m**2, sensor.altitude**2
+
+
+def covariance_traces(
+    P0: np.ndarray,
+    uav_xy: np.ndarray,
+    target_xy: np.ndarray,
+    dt: float,
+    Q: np.ndarray,
+    sensor: SensorModel,
+) -> np.ndarray:
+    """Compiled twin of :func:`rsmhp.uav.kernel.covariance_traces`: ``tr P_j`` (C, T, H) for
+    UAV positions ``uav_xy`` (C, H, 2) and hypotheses ``target_xy`` (T, H, 2)."""
+    uav_xy = np.ascontiguousarray(uav_xy, dtype=float)
+    target_xy = np.ascontiguousarray(target_xy, dtype=float)
+    out = np.empty((uav_xy.shape[0], target_xy.shape[0], uav_xy.shape[1]))
+    fr2, fc2, h2 = _sensor_args(sensor)
+    P0 = np.asarray(P0, dtype=float)
+    Q = np.asarray(Q, dtype=float)
+    return _traces_kernel(
+        _entries(P0), uav_xy, target_xy, float(dt), _entries(Q), fr2, fc2, h2, out
+    )
+
+
+class Frozen:
+    """The arguments that stay fixed during one planning step (UAV state, aircraft, posterior,
+    hypotheses, target model, sensor), converted once for :func:`evaluate`."""
+
+    __slots__ = ("args",)
+
+    def __init__(self, uav_state, uav, P0, target_xy, target_dt, Q, sensor) -> None:
+        fr2, fc2, h2 = _sensor_args(sensor)
+        self.args = (
+            np.ascontiguousarray(uav_state, dtype=float),
+            np.array([uav.accel_max, uav.bank_max]),
+            float(uav.dt),
+            float(uav.g),
+            float(uav.speed_min),
+            float(uav.speed_max),
+            _entries(np.asarray(P0, dtype=float)),
+            np.ascontiguousarray(target_xy, dtype=float),
+            float(target_dt),
+            _entries(np.asarray(Q, dtype=float)),
+            fr2,
+            fc2,
+            h2,
+        )
+
+
+def evaluate(x: np.ndarray, frozen: Frozen, want_grad: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Costs (C,) and, if ``want_grad``, gradients (C, 2H) of ``x`` (C, 2H) (else (0, 0))."""
+    x = np.ascontiguousarray(x, dtype=float)
+    if x.ndim != 2:
+        raise ValueError(f"x must have shape (C, 2H), got {x.shape}")
+    n_c = x.shape[0]
+    cost_out = np.empty(n_c)
+    grad_out = np.empty((n_c, x.shape[1]) if want_grad else (0, 0))
+    st, sc, udt, g, smin, smax, p0, txy, tdt, q, fr2, fc2, h2 = frozen.args
+    if txy.shape[1] != x.shape[1] // 2:
+        raise ValueError(f"target_xy has {txy.shape[1]} steps, x has {x.shape[1] // 2}")
+    return _cost_grad_kernel(
+        x, st, sc, udt, g, smin, smax, p0, txy, tdt, q, fr2, fc2, h2, want_grad, cost_out, grad_out
+    )
+
+
+def cost_and_grad(
+    x: np.ndarray,
+    uav_state: np.ndarray,
+    uav: UAVParams,
+    P0: np.ndarray,
+    target_xy: np.ndarray,
+    target_dt: float,
+    Q: np.ndarray,
+    sensor: SensorModel,
+) -> tuple[np.ndarray, np.ndarray]:
+    r"""Planner cost :math:`J` (C,) and exact gradient :math:`\nabla_x J` (C, 2H) of normalised
+    control sequences ``x`` (C, 2H) from UAV state ``uav_state`` (4,), posterior ``P0`` (4, 4)
+    and hypotheses ``target_xy`` (T, H, 2) (m², per unit of normalised control)."""
+    frozen = Frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor)
+    return evaluate(np.atleast_2d(x), frozen, True)
+
+
+def cost(
+    x: np.ndarray,
+    uav_state: np.ndarray,
+    uav: UAVParams,
+    P0: np.ndarray,
+    target_xy: np.ndarray,
+    target_dt: float,
+    Q: np.ndarray,
+    sensor: SensorModel,
+) -> np.ndarray:
+    """Planner cost only (C,) (see :func:`cost_and_grad`)."""
+    frozen = Frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor)
+    return evaluate(np.atleast_2d(x), frozen, False)[0]
+
+
+def warm_up() -> float:
+    """Compile (or load from the cache) every kernel; returns the seconds it took."""
+    import time
+
+    t0 = time.perf_counter()
+    uav = UAVParams(1.0, 9.81, 3.0, 0.7, 10.0, 35.0, 100.0)
+    sensor = SensorModel(0.05, 0.1, 100.0)
+    txy = np.zeros((1, 2, 2))
+    cost_and_grad(
+        np.zeros((1, 4)), np.array([1.0, 0, 20, 0]), uav, np.eye(4), txy, 1.0, np.eye(4), sensor
+    )
+    cost(np.zeros((1, 4)), np.array([1.0, 0, 20, 0]), uav, np.eye(4), txy, 1.0, np.eye(4), sensor)
+    covariance_traces(np.eye(4), np.zeros((1, 2, 2)), txy, 1.0, np.eye(4), sensor)
+    return time.perf_counter() - t0
