@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 from numpy.polynomial.hermite_e import hermegauss
-from scipy import stats
+from scipy import special
 from scipy.stats import qmc
 
 __all__ = [
@@ -41,7 +41,11 @@ DETERMINISTIC = ("cubature", "gauss_hermite")
 
 
 def _shape(z: np.ndarray, H: int, chol: np.ndarray) -> np.ndarray:
+    """``z`` (n, H d) -> (n, H, d), :math:`w_k = L z_k`. For d = 1 an elementwise product
+    (the same single rounding as the 1x1 matrix product, and much faster)."""
     d = chol.shape[0]
+    if d == 1:
+        return z.reshape(z.shape[0], H, 1) * chol[0, 0]
     return z.reshape(z.shape[0], H, d) @ chol.T
 
 
@@ -68,7 +72,7 @@ def sobol(rng: np.random.Generator, n: int, H: int, chol: np.ndarray):
     engine = qmc.Sobol(d=D, scramble=True, rng=rng)
     u = engine.random(n)
     # scrambled points never hit 0 or 1 exactly, but guard the quantile anyway
-    z = stats.norm.ppf(np.clip(u, 1e-15, 1 - 1e-15))
+    z = special.ndtri(np.clip(u, 1e-15, 1 - 1e-15))  # the normal quantile, Phi^-1
     return _shape(z, H, chol), np.full(n, 1.0 / n)
 
 

@@ -35,8 +35,11 @@ __all__ = [
     "Trajectories",
     "TreeLevel",
     "TreeSample",
+    "rollout",
+    "rollout_cost",
     "sample_independent",
     "sample_tree",
+    "sample_tree_batch",
     "top_m",
 ]
 
@@ -54,12 +57,20 @@ class GaussianNoise:
         cov = np.atleast_2d(np.asarray(cov, dtype=float))
         if cov.shape[0] != cov.shape[1]:
             raise ValueError(f"noise covariance must be square, got shape {cov.shape}")
-        if not np.allclose(cov, cov.T):
+        if not (np.array_equal(cov, cov.T) or np.allclose(cov, cov.T)):
             raise ValueError("noise covariance must be symmetric")
         self.cov = cov
         self.dim = cov.shape[0]
         self._chol = np.linalg.cholesky(cov)  # raises LinAlgError if not positive definite
         self._log_norm = -0.5 * (self.dim * np.log(2 * np.pi)) - np.sum(np.log(np.diag(self._chol)))
+
+    @property
+    def rowwise(self) -> bool:
+        """Whether :meth:`logpdf` of a row is independent of the rest of the batch, bit for bit
+        (then the tree evaluates each shared draw once). True for ``d = 1`` (elementwise); a
+        batched LAPACK solve (``d > 1``) may round a row differently in batches of other sizes.
+        """
+        return self.dim == 1
 
     @property
     def chol(self) -> np.ndarray:
@@ -172,16 +183,10 @@ def top_m(log_likeliness: np.ndarray, m: int) -> np.ndarray:
     return order[:m]
 
 
-def rollout(
-    system: System, x0: np.ndarray, u: np.ndarray | list[float], noise: np.ndarray
-) -> Trajectories:
-    """Propagate given noise sequences: ``noise`` has shape ``(n, H, dw)`` with ``H = len(u)``.
-
-    Every sampler (plain Monte Carlo, antithetic, quasi-Monte Carlo, quadrature nodes) produces
-    noise sequences and calls this; the trajectory costs it returns are then averaged.
-    """
-    u = _controls(u)
-    noise = np.asarray(noise, dtype=float)
+def _propagate(
+    system: System, x0: np.ndarray, u: np.ndarray, noise: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """States (n, H+1, dx) and costs (n,) of given noise sequences (n, H, dw)."""
     horizon = u.shape[0]
     if noise.ndim != 3 or noise.shape[1] != horizon or noise.shape[2] != system.noise.dim:
         raise ValueError(
@@ -198,8 +203,29 @@ def rollout(
         x = system.step(x, u[k], noise[:, k])
         states[:, k + 1] = x
     cost += system.terminal_cost(x)
+    return states, cost
+
+
+def rollout(
+    system: System, x0: np.ndarray, u: np.ndarray | list[float], noise: np.ndarray
+) -> Trajectories:
+    """Propagate given noise sequences: ``noise`` has shape ``(n, H, dw)`` with ``H = len(u)``.
+
+    Every sampler (plain Monte Carlo, antithetic, quasi-Monte Carlo, quadrature nodes) produces
+    noise sequences and calls this; the trajectory costs it returns are then averaged.
+    """
+    noise = np.asarray(noise, dtype=float)
+    states, cost = _propagate(system, x0, _controls(u), noise)
     loglik = system.noise.logpdf(noise).sum(axis=1)
     return Trajectories(states=states, noise=noise, log_likeliness=loglik, cost=cost)
+
+
+def rollout_cost(
+    system: System, x0: np.ndarray, u: np.ndarray | list[float], noise: np.ndarray
+) -> np.ndarray:
+    """Only the costs (n,) of :func:`rollout` (same arithmetic), without the likeliness, for
+    estimators that do not weight by it."""
+    return _propagate(system, x0, _controls(u), np.asarray(noise, dtype=float))[1]
 
 
 def sample_independent(
@@ -271,12 +297,17 @@ def sample_tree(
         if shared_draws:
             w_new = noise.sample(rng, n_branch)  # (N, dw)
             w_child = np.tile(w_new, (n_nodes, 1))
+            # the same N densities for every node: evaluate them once where that is exact
+            ll_w = np.tile(noise.logpdf(w_new), n_nodes) if noise.rowwise else None
         else:
             w_child = noise.sample(rng, (n_nodes, n_branch)).reshape(-1, noise.dim)
+            ll_w = None
+        if ll_w is None:
+            ll_w = noise.logpdf(w_child)
         parent = np.repeat(np.arange(n_nodes), n_branch)
         cost_parent = cost + system.stage_cost(x, u[k])
         x_child = system.step(x[parent], u[k], w_child)
-        ll_child = loglik[parent] + noise.logpdf(w_child)
+        ll_child = loglik[parent] + ll_w
         if max_keep is not None and x_child.shape[0] > max_keep:
             keep = np.sort(top_m(ll_child, max_keep))  # keep tree order for readability
         else:
@@ -292,3 +323,70 @@ def sample_tree(
     cost = cost + system.terminal_cost(x)
     leaves = Trajectories(states=paths, noise=w_paths, log_likeliness=loglik, cost=cost)
     return TreeSample(leaves=leaves, history=history)
+
+
+def sample_tree_batch(
+    system: System,
+    x0: np.ndarray,
+    u: np.ndarray | list[float],
+    n_branch: int,
+    rngs: Sequence[np.random.Generator],
+    *,
+    max_keep: int | None = None,
+    shared_draws: bool = True,
+) -> tuple[np.ndarray, np.ndarray]:
+    """``R = len(rngs)`` independent trees at once: leaf costs and log-likeliness, (R, m) each.
+
+    Tree ``r`` is :func:`sample_tree` with generator ``rngs[r]`` (same draws in the same
+    order, same pruning, ties broken the same way); only the arithmetic runs on all trees
+    together. When the system's step and costs act row by row and ``system.noise.rowwise``
+    holds (every scalar problem here), the result equals :func:`sample_tree` bit for bit
+    (tested); otherwise it agrees up to rounding. Leaves are in tree order, as in
+    :func:`sample_tree`.
+    """
+    u = _controls(u)
+    if n_branch < 1:
+        raise ValueError(f"N (draws per step) must be >= 1, got {n_branch}")
+    if max_keep is not None and max_keep < 1:
+        raise ValueError(f"M (trajectories kept) must be >= 1, got {max_keep}")
+    rngs = list(rngs)
+    if not rngs:
+        raise ValueError("need at least one generator (one tree per generator)")
+    horizon, noise = u.shape[0], system.noise
+    n_trees, dw = len(rngs), noise.dim
+    x0 = np.atleast_1d(np.asarray(x0, dtype=float))
+    dx = x0.size
+    x = np.broadcast_to(x0, (n_trees, 1, dx)).copy()
+    loglik = np.zeros((n_trees, 1))
+    cost = np.zeros((n_trees, 1))
+    for k in range(horizon):
+        n_nodes = x.shape[1]
+        n_child = n_nodes * n_branch
+        if shared_draws:
+            w_new = np.stack([noise.sample(g, n_branch) for g in rngs])  # (R, N, dw)
+            w_child = np.tile(w_new, (1, n_nodes, 1))
+            if noise.rowwise:
+                ll_w = np.tile(noise.logpdf(w_new), (1, n_nodes))
+            else:
+                ll_w = noise.logpdf(w_child)
+        else:
+            w_child = np.stack([noise.sample(g, (n_nodes, n_branch)).reshape(-1, dw) for g in rngs])
+            ll_w = noise.logpdf(w_child)
+        parent = np.repeat(np.arange(n_nodes), n_branch)
+        stage = system.stage_cost(x.reshape(-1, dx), u[k]).reshape(n_trees, n_nodes)
+        cost_parent = cost + stage
+        x_child = system.step(x[:, parent].reshape(-1, dx), u[k], w_child.reshape(-1, dw)).reshape(
+            n_trees, n_child, dx
+        )
+        ll_child = loglik[:, parent] + ll_w
+        if max_keep is not None and n_child > max_keep:
+            order = np.argsort(-ll_child, axis=1, kind="stable")[:, :max_keep]
+            keep = np.sort(order, axis=1)
+        else:
+            keep = np.broadcast_to(np.arange(n_child), (n_trees, n_child))
+        x = np.take_along_axis(x_child, keep[..., None], axis=1)
+        loglik = np.take_along_axis(ll_child, keep, axis=1)
+        cost = np.take_along_axis(cost_parent[:, parent], keep, axis=1)
+    m = x.shape[1]
+    cost = cost + system.terminal_cost(x.reshape(-1, dx)).reshape(n_trees, m)
+    return cost, loglik

@@ -16,12 +16,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-from collections.abc import Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
 import numpy as np
 
-__all__ = ["canonical_job_id", "job_rng", "job_seed_sequence"]
+__all__ = ["canonical_job_id", "job_rng", "job_rngs", "job_seed_sequence"]
 
 
 def _plain(value: Any) -> Any:
@@ -52,8 +52,19 @@ def canonical_job_id(experiment: str, /, **params: Any) -> str:
         raise ValueError("experiment name must be a non-empty string")
     if "experiment" in params:
         raise ValueError("'experiment' is reserved in job identifiers")
-    payload = {"experiment": experiment, **{k: _plain(v) for k, v in params.items()}}
+    return _dump({"experiment": experiment, **{k: _plain(v) for k, v in params.items()}})
+
+
+def _dump(payload: Mapping[str, Any]) -> str:
     return json.dumps(payload, sort_keys=True, separators=(",", ":"), allow_nan=False)
+
+
+def _seed_sequence(root_seed: Any, job_id: str) -> np.random.SeedSequence:
+    if not isinstance(root_seed, (int, np.integer)) or root_seed < 0:
+        raise ValueError(f"root_seed must be a non-negative integer, got {root_seed!r}")
+    digest = hashlib.blake2b(job_id.encode("utf-8"), digest_size=16).digest()
+    words = tuple(int(w) for w in np.frombuffer(digest, dtype="<u4"))
+    return np.random.SeedSequence(entropy=int(root_seed), spawn_key=words)
 
 
 def job_seed_sequence(root_seed: int, experiment: str, /, **params: Any) -> np.random.SeedSequence:
@@ -61,15 +72,27 @@ def job_seed_sequence(root_seed: int, experiment: str, /, **params: Any) -> np.r
 
     The spawn key is the digest split into four little-endian uint32 words.
     """
-    if not isinstance(root_seed, (int, np.integer)) or root_seed < 0:
-        raise ValueError(f"root_seed must be a non-negative integer, got {root_seed!r}")
-    digest = hashlib.blake2b(
-        canonical_job_id(experiment, **params).encode("utf-8"), digest_size=16
-    ).digest()
-    words = tuple(int(w) for w in np.frombuffer(digest, dtype="<u4"))
-    return np.random.SeedSequence(entropy=int(root_seed), spawn_key=words)
+    return _seed_sequence(root_seed, canonical_job_id(experiment, **params))
 
 
 def job_rng(root_seed: int, experiment: str, /, **params: Any) -> np.random.Generator:
     """A PCG64 :class:`numpy.random.Generator` seeded by :func:`job_seed_sequence`."""
     return np.random.Generator(np.random.PCG64(job_seed_sequence(root_seed, experiment, **params)))
+
+
+def job_rngs(
+    root_seed: int, experiment: str, key: str, values: Iterable[Any], /, **params: Any
+) -> Iterator[np.random.Generator]:
+    """``job_rng(root_seed, experiment, **params, key=v)`` for every ``v`` in ``values``
+    (identical streams), converting the shared ``params`` only once (e.g. the replicates of
+    one grid cell)."""
+    if not experiment:
+        raise ValueError("experiment name must be a non-empty string")
+    if "experiment" in params or key == "experiment":
+        raise ValueError("'experiment' is reserved in job identifiers")
+    if key in params:
+        raise ValueError(f"{key!r} is both the varying key and a fixed parameter")
+    base = {"experiment": experiment, **{k: _plain(v) for k, v in params.items()}}
+    for v in values:
+        seq = _seed_sequence(root_seed, _dump({**base, key: _plain(v)}))
+        yield np.random.Generator(np.random.PCG64(seq))

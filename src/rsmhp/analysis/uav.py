@@ -322,9 +322,9 @@ def uav_section(
             f"{setting['tracker']['p0_pos_sd']:g}², {setting['tracker']['p0_vel_sd']:g}², "
             f"{setting['tracker']['p0_vel_sd']:g}²). Planner: H = {pl['horizon']}, cost "
             "Σ_{k=1..H} tr P_k averaged over the hypotheses, L-BFGS-B on the control box with "
-            f"at most {pl['maxiter']} iterations / {pl['maxfun']} evaluations, batched "
-            "forward-difference gradient, warm start from the shifted previous plan; identical "
-            "for every method.",
+            f"at most {pl['maxiter']} iterations / {pl['maxfun']} evaluations, exact gradient "
+            "(adjoint of the covariance recursion and the kinematics, compiled kernel), warm "
+            "start from the shifted previous plan; identical for every method.",
             "",
             f"Study: {n_runs} runs × {sc['steps']} steps per method. Each run draws its scenario "
             f"(target speed {sc['target_speed_min']:g}-{sc['target_speed_max']:g} m/s, UAV "

@@ -23,6 +23,9 @@ scheme         sample                                          n_trajectories   
 Uniform and weighted rows of a replicate are computed from the *same* sample (paired).
 ``cpu_seconds`` is the process CPU time of drawing the sample and forming the estimate; it is the
 only column that is not reproducible bit for bit. Deterministic schemes have one replicate.
+Trees of the scalar problems (one-dimensional noise) are sampled for many replicates at once
+(:func:`rsmhp.sampling.sample_tree_batch`, bit-identical estimates); their ``cpu_seconds`` is
+the batch's sampling time divided by its replicates, plus the replicate's own estimate time.
 """
 
 from __future__ import annotations
@@ -40,8 +43,8 @@ from rsmhp import samplers
 from rsmhp.estimators import uniform_estimate, weighted_estimate
 from rsmhp.linear_quadratic import LinearQuadratic
 from rsmhp.parallel import parallel_map
-from rsmhp.sampling import rollout, sample_tree
-from rsmhp.seeding import job_rng
+from rsmhp.sampling import rollout, rollout_cost, sample_tree, sample_tree_batch
+from rsmhp.seeding import job_rngs
 
 __all__ = ["ABLATION_COLUMNS", "GridPoint", "build_problem", "grid_points", "run_ablation"]
 
@@ -156,7 +159,7 @@ def _sample(point: GridPoint, prob: LinearQuadratic, rng: np.random.Generator | 
         return traj.cost, traj.log_likeliness, None, point.n * H
     if s in ("antithetic", "sobol"):
         w, wt = getattr(samplers, s)(rng, point.n, H, chol)
-        return rollout(prob, prob.x0, prob.u, w).cost, None, wt, point.n * H
+        return rollout_cost(prob, prob.x0, prob.u, w), None, wt, point.n * H
     if s in ("tree", "tree_pernode", "pruned"):
         tree = sample_tree(
             prob,
@@ -167,44 +170,84 @@ def _sample(point: GridPoint, prob: LinearQuadratic, rng: np.random.Generator | 
             max_keep=point.M if s == "pruned" else None,
             shared_draws=s != "tree_pernode",
         )
-        if s == "pruned":
-            nodes, n_keep = 0, 1
-            for _ in range(H):
-                nodes += n_keep * point.N
-                n_keep = min(point.M, n_keep * point.N)
-        else:
-            nodes = sum(point.N**k for k in range(1, H + 1))
-        return tree.leaves.cost, tree.leaves.log_likeliness, None, nodes
+        return tree.leaves.cost, tree.leaves.log_likeliness, None, _tree_nodes(point, H)
     if s == "cubature":
         w, wt = samplers.cubature(H, chol)
-        return rollout(prob, prob.x0, prob.u, w).cost, None, wt, len(wt) * H
+        return rollout_cost(prob, prob.x0, prob.u, w), None, wt, len(wt) * H
     if s == "gauss_hermite":
         w, wt = samplers.gauss_hermite(point.N, H, chol)
-        return rollout(prob, prob.x0, prob.u, w).cost, None, wt, len(wt) * H
+        return rollout_cost(prob, prob.x0, prob.u, w), None, wt, len(wt) * H
     if s == "nbo":
-        traj = rollout(prob, prob.x0, prob.u, np.zeros((1, H, prob.d)))
-        return traj.cost, None, np.ones(1), H
+        return rollout_cost(prob, prob.x0, prob.u, np.zeros((1, H, prob.d))), None, np.ones(1), H
     raise ValueError(f"unknown scheme {s!r}")
+
+
+def _tree_nodes(point: GridPoint, H: int) -> int:
+    """Nodes drawn by a (pruned) tree: sum over levels of the children created."""
+    if point.scheme != "pruned":
+        return sum(point.N**k for k in range(1, H + 1))
+    nodes, n_keep = 0, 1
+    for _ in range(H):
+        nodes += n_keep * point.N
+        n_keep = min(point.M, n_keep * point.N)
+    return nodes
+
+
+# trees of one cell sampled together (bounded memory: leaves x replicates per batch)
+_BATCH_LEAVES = 1 << 20
+
+
+def _batched_tree_samples(point: GridPoint, prob: LinearQuadratic, rngs: list) -> Iterator:
+    """(cost, loglik, cpu seconds per replicate) of every replicate of a tree cell, sampled
+    with :func:`rsmhp.sampling.sample_tree_batch` (bit-identical to one tree at a time for
+    these row-wise problems; see its docstring)."""
+    leaves = point.M if point.scheme == "pruned" else point.N**prob.H
+    per_batch = max(1, _BATCH_LEAVES // max(leaves, 1))
+    for start in range(0, len(rngs), per_batch):
+        chunk = rngs[start : start + per_batch]
+        t0 = time.process_time()
+        cost, loglik = sample_tree_batch(
+            prob,
+            prob.x0,
+            prob.u,
+            point.N,
+            chunk,
+            max_keep=point.M if point.scheme == "pruned" else None,
+            shared_draws=point.scheme != "tree_pernode",
+        )
+        cpu = (time.process_time() - t0) / len(chunk)
+        for r in range(len(chunk)):
+            yield cost[r], loglik[r], cpu
 
 
 def _rows(point: GridPoint, prob: LinearQuadratic, spec: Mapping, seed: int, reps: int) -> Iterator:
     j_exact, j_nbo = prob.exact_cost(), prob.nbo_cost()
-    for rep in range(1 if point.deterministic else reps):
-        rng = None
-        if not point.deterministic:
-            rng = job_rng(
-                seed,
-                "estimators",
-                problem=point.problem,
-                spec=spec,
-                scheme=point.scheme,
-                N=point.N,
-                M=point.M,
-                n=point.n,
-                replicate=rep,
-            )
+    n_reps = 1 if point.deterministic else reps
+    rngs = job_rngs(
+        seed,
+        "estimators",
+        "replicate",
+        range(n_reps),
+        problem=point.problem,
+        spec=spec,
+        scheme=point.scheme,
+        N=point.N,
+        M=point.M,
+        n=point.n,
+    )
+    batched = None
+    if point.scheme in ("tree", "tree_pernode", "pruned") and prob.noise.rowwise:
+        batched = _batched_tree_samples(point, prob, list(rngs))
+        rngs = range(n_reps)
+    for rep, stream in enumerate(rngs):
+        rng = None if point.deterministic else stream
         t0 = time.process_time()
-        cost, loglik, wts, nodes = _sample(point, prob, rng)
+        if batched is not None:
+            cost, loglik, cpu_sample = next(batched)
+            wts, nodes = None, _tree_nodes(point, prob.H)
+        else:
+            cost, loglik, wts, nodes = _sample(point, prob, rng)
+            cpu_sample = 0.0
         if wts is not None:
             estimates = {
                 "quadrature"
@@ -217,7 +260,7 @@ def _rows(point: GridPoint, prob: LinearQuadratic, spec: Mapping, seed: int, rep
             estimates = {"uniform": float(uniform_estimate(cost))}
             if point.scheme in WEIGHTED_SCHEMES:
                 estimates["weighted"] = float(weighted_estimate(cost, loglik))
-        cpu = time.process_time() - t0
+        cpu = time.process_time() - t0 + cpu_sample
         for weighting, est in estimates.items():
             yield {
                 "problem": point.problem,

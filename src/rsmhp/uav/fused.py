@@ -64,7 +64,15 @@ from numba import njit
 from rsmhp.uav.kinematics import UAVParams
 from rsmhp.uav.sensor import SensorModel
 
-__all__ = ["Frozen", "cost", "cost_and_grad", "covariance_traces", "evaluate", "warm_up"]
+__all__ = [
+    "Frozen",
+    "cost",
+    "cost_and_grad",
+    "covariance_traces",
+    "evaluate",
+    "path",
+    "warm_up",
+]
 
 
 # --------------------------------------------------------------------------------------------
@@ -225,6 +233,42 @@ def _meas_cov_grad(ux, uy, tx, ty, rbar, fr2, fc2, h2):  # pragma: no cover - co
     return -gvx, -gvy
 
 
+@njit(cache=True, inline="always")
+def _kinematics(
+    xc, state0, amax, phimax, dt, g, smin, smax, uxy, spd, hdg, inside
+):  # pragma: no cover
+    """Rollout of one normalised control sequence ``xc`` (2H,): positions ``uxy`` (H, 2),
+    speeds and headings ``spd``, ``hdg`` (H+1,) (entry 0 = start), and whether each speed
+    update stayed strictly inside the bounds. rsmhp.uav.kinematics.step, same operation order.
+    """
+    px, py = state0[0], state0[1]
+    spd[0], hdg[0] = state0[2], state0[3]
+    for j in range(uxy.shape[0]):
+        a = min(max(xc[2 * j] * amax, -amax), amax)
+        phi = min(max(xc[2 * j + 1] * phimax, -phimax), phimax)
+        v = spd[j] + a * dt
+        inside[j] = smin < v < smax
+        s_new = min(max(v, smin), smax)
+        h_new = hdg[j] + g * np.tan(phi) / spd[j] * dt
+        px = px + s_new * dt * np.cos(h_new)
+        py = py + s_new * dt * np.sin(h_new)
+        spd[j + 1], hdg[j + 1] = s_new, h_new
+        uxy[j, 0], uxy[j, 1] = px, py
+
+
+@njit(cache=True, nogil=True)
+def _path_kernel(xc, state0, scale, dt, g, smin, smax, out):  # pragma: no cover - compiled
+    horizon = xc.shape[0] // 2
+    uxy = np.empty((horizon, 2))
+    spd = np.empty(horizon + 1)
+    hdg = np.empty(horizon + 1)
+    inside = np.empty(horizon, dtype=np.bool_)
+    _kinematics(xc, state0, scale[0], scale[1], dt, g, smin, smax, uxy, spd, hdg, inside)
+    for j in range(horizon):
+        out[j, 0], out[j, 1], out[j, 2], out[j, 3] = uxy[j, 0], uxy[j, 1], spd[j + 1], hdg[j + 1]
+    return out
+
+
 @njit(cache=True, nogil=True)
 def _cost_grad_kernel(
     x, state0, scale, uav_dt, g, smin, smax, p0, txy, tdt, q, fr2, fc2, h2, want_grad, cost, grad
@@ -240,20 +284,7 @@ def _cost_grad_kernel(
     gxy = np.empty((horizon, 2))
     amax, phimax = scale[0], scale[1]
     for c in range(n_c):
-        # ---- kinematics (rsmhp.uav.kinematics.step, same operation order)
-        px, py = state0[0], state0[1]
-        spd[0], hdg[0] = state0[2], state0[3]
-        for j in range(horizon):
-            a = min(max(x[c, 2 * j] * amax, -amax), amax)
-            phi = min(max(x[c, 2 * j + 1] * phimax, -phimax), phimax)
-            v = spd[j] + a * uav_dt
-            inside[j] = smin < v < smax
-            s_new = min(max(v, smin), smax)
-            h_new = hdg[j] + g * np.tan(phi) / spd[j] * uav_dt
-            px = px + s_new * uav_dt * np.cos(h_new)
-            py = py + s_new * uav_dt * np.sin(h_new)
-            spd[j + 1], hdg[j + 1] = s_new, h_new
-            uxy[j, 0], uxy[j, 1] = px, py
+        _kinematics(x[c], state0, amax, phimax, uav_dt, g, smin, smax, uxy, spd, hdg, inside)
         # ---- covariance recursion per hypothesis, and its adjoint
         total = 0.0
         for j in range(horizon):
@@ -404,6 +435,14 @@ def evaluate(x: np.ndarray, frozen: Frozen, want_grad: bool) -> tuple[np.ndarray
     )
 
 
+def path(x: np.ndarray, frozen: Frozen) -> np.ndarray:
+    """UAV states (H, 4) after each control of the normalised sequence ``x`` (2H,): the
+    compiled twin of :func:`rsmhp.uav.kinematics.rollout` (same operation order)."""
+    x = np.ascontiguousarray(x, dtype=float).ravel()
+    st, sc, udt, g, smin, smax = frozen.args[:6]
+    return _path_kernel(x, st, sc, udt, g, smin, smax, np.empty((x.size // 2, 4)))
+
+
 def cost_and_grad(
     x: np.ndarray,
     uav_state: np.ndarray,
@@ -443,10 +482,10 @@ def warm_up() -> float:
     t0 = time.perf_counter()
     uav = UAVParams(1.0, 9.81, 3.0, 0.7, 10.0, 35.0, 100.0)
     sensor = SensorModel(0.05, 0.1, 100.0)
-    txy = np.zeros((1, 2, 2))
-    cost_and_grad(
-        np.zeros((1, 4)), np.array([1.0, 0, 20, 0]), uav, np.eye(4), txy, 1.0, np.eye(4), sensor
-    )
-    cost(np.zeros((1, 4)), np.array([1.0, 0, 20, 0]), uav, np.eye(4), txy, 1.0, np.eye(4), sensor)
-    covariance_traces(np.eye(4), np.zeros((1, 2, 2)), txy, 1.0, np.eye(4), sensor)
+    txy, eye, state = np.zeros((1, 2, 2)), np.eye(4), np.array([1.0, 0.0, 20.0, 0.0])
+    frozen = Frozen(state, uav, eye, txy, 1.0, eye, sensor)
+    evaluate(np.zeros((1, 4)), frozen, want_grad=True)
+    evaluate(np.zeros((1, 4)), frozen, want_grad=False)
+    covariance_traces(eye, np.zeros((1, 2, 2)), txy, 1.0, eye, sensor)
+    path(np.zeros(4), frozen)
     return time.perf_counter() - t0

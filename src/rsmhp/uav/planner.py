@@ -18,14 +18,15 @@ zeros at the first step).
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.optimize import minimize
+from scipy.optimize import Bounds, minimize
 
-from rsmhp.uav import fused, kinematics
+from rsmhp.uav import fused
 from rsmhp.uav.kinematics import UAVParams
 from rsmhp.uav.sensor import SensorModel
 from rsmhp.uav.target import TargetModel
@@ -119,6 +120,13 @@ def shift_plan(controls: np.ndarray) -> np.ndarray:
     return np.vstack([controls[1:], controls[-1:]])
 
 
+@functools.cache
+def _box(n: int) -> Bounds:
+    """The normalised control box [-1, 1]^n (built once per size: scipy's bounds parsing is a
+    large share of a small problem's optimiser overhead)."""
+    return Bounds(np.full(n, -1.0), np.full(n, 1.0))
+
+
 def plan(problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
     """Minimise the problem's cost from ``warm_start`` (H, 2) controls with L-BFGS-B."""
     x0 = np.clip(np.asarray(warm_start, dtype=float).ravel() / problem.scale, -1.0, 1.0)
@@ -128,7 +136,7 @@ def plan(problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
         x0,
         jac=True,
         method="L-BFGS-B",
-        bounds=[(-1.0, 1.0)] * x0.size,
+        bounds=_box(x0.size),
         options={"maxiter": problem.params.maxiter, "maxfun": problem.params.maxfun},
     )
     x_best, f_best = (res.x, float(res.fun)) if res.fun <= f0 else (x0, f0)
@@ -139,5 +147,5 @@ def plan(problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
         cost_warm=f0,
         nit=int(res.nit),
         n_kernel_calls=problem.n_kernel_calls,
-        uav_path=kinematics.rollout(problem.uav_state, controls, problem.uav),
+        uav_path=fused.path(x_best, problem._frozen),
     )

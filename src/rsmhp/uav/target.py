@@ -28,6 +28,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -36,6 +37,7 @@ from rsmhp.sampling import GaussianNoise, top_m
 from rsmhp.sampling import sample_tree as _sample_tree
 
 __all__ = [
+    "HypothesisNoise",
     "TargetModel",
     "nominal",
     "process_noise",
@@ -80,6 +82,37 @@ class TargetModel:
     @property
     def Q(self) -> np.ndarray:
         return process_noise(self.dt, self.q)
+
+    @cached_property
+    def noise(self) -> GaussianNoise:
+        r""":math:`\mathcal N(0, Q)` with its Cholesky factor (built once per model)."""
+        return HypothesisNoise(self.Q)
+
+
+class HypothesisNoise(GaussianNoise):
+    r""":class:`rsmhp.sampling.GaussianNoise` whose log-density solves :math:`L y = w` by
+    forward substitution, column by column over the whole batch,
+    :math:`y_i = (w_i - \sum_{j<i} L_{ij} y_j) / L_{ii}`, instead of a general LU solve:
+    several times faster for the tree's hundreds of 4-D draws per level, and every row's
+    value independent of the batch it is evaluated in (a batched LAPACK solve is not)."""
+
+    @property
+    def rowwise(self) -> bool:
+        return True
+
+    def logpdf(self, w: np.ndarray) -> np.ndarray:
+        w = np.asarray(w, dtype=float)
+        flat = w.reshape(-1, self.dim)
+        L = self.chol
+        y = np.empty_like(flat)
+        quad = np.zeros(flat.shape[0])
+        for i in range(self.dim):
+            acc = flat[:, i].copy()
+            for j in range(i):
+                acc -= L[i, j] * y[:, j]
+            y[:, i] = acc / L[i, i]
+            quad += y[:, i] * y[:, i]
+        return (self._log_norm - 0.5 * quad).reshape(w.shape[:-1])
 
 
 def _chol(P: np.ndarray) -> np.ndarray:
@@ -162,9 +195,9 @@ def sample_tree(
     nodes; after every level the ``M`` most likely trajectories are kept. Survivors are
     returned sorted by decreasing likeliness (ties by tree order).
     """
-    noise = GaussianNoise(model.Q)
+    noise = model.noise
     system = _Hypotheses(F=model.F, noise=noise)
-    levels = [GaussianNoise(0.5 * (P_hat + P_hat.T))] + [noise] * horizon
+    levels = [HypothesisNoise(0.5 * (P_hat + P_hat.T))] + [noise] * horizon
     tree = _sample_tree(
         system,
         np.asarray(x_hat, dtype=float),
