@@ -16,6 +16,8 @@ $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
+	@# compile the numba planner kernels once per machine (on-disk cache; every job loads it)
+	$(BIN)/python -c 'from rsmhp.uav import fused; print(f"planner kernels compiled in {fused.warm_up():.1f} s")'
 	@touch $(STAMP)
 
 setup: $(STAMP)

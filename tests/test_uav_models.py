@@ -121,6 +121,42 @@ def test_sample_tree_without_and_with_pruning(rng):
         assert len(np.unique(np.round(w, 9), axis=0)) <= 3
 
 
+@pytest.mark.parametrize("seed", range(40))
+def test_compiled_tree_equals_generic_sampler(seed):
+    """The compiled pruned tree against the generic :func:`rsmhp.sampling.sample_tree` on the
+    same stream: same leaves in the same order (log-likeliness to rounding), same paths."""
+    r = np.random.default_rng(1000 + seed)
+    A = r.normal(size=(4, 4))
+    P = A @ A.T * 10.0 ** r.uniform(-3, 3) + 1e-6 * np.eye(4)
+    x = r.normal(size=4) * 100
+    model = TargetModel(float(r.uniform(0.2, 2.0)), float(10.0 ** r.uniform(-2, 1)))
+    H, N, M = int(r.integers(1, 7)), int(r.integers(1, 9)), int(r.integers(1, 150))
+    got, ll = target.sample_tree(x, P, H, N, M, model, np.random.default_rng(seed))
+    ref, ll_ref = target.sample_tree_reference(x, P, H, N, M, model, np.random.default_rng(seed))
+    assert got.shape == ref.shape == (min(M, N ** (H + 1)), H, 4)
+    np.testing.assert_allclose(ll, ll_ref, rtol=1e-12, atol=1e-12)
+    scale = max(1.0, np.abs(ref).max())
+    assert np.abs(got - ref).max() <= 1e-12 * scale
+
+
+@pytest.mark.parametrize("m", [1, 3, 7, 12, 19])
+def test_tree_pruning_keeps_what_a_stable_sort_keeps(m):
+    """Ties at the pruning threshold go to the lower index, as with a stable descending sort."""
+    vals = np.random.default_rng(m).integers(0, 5, size=20).astype(float)  # many ties
+    expected = np.sort(np.argsort(-vals, kind="stable")[:m])
+    np.testing.assert_array_equal(target._keep_top(vals, m), expected)
+
+
+def test_sample_tree_refuses_bad_arguments(rng):
+    model, P = TargetModel(1.0, 1.0), np.eye(4)
+    for bad, name in (({"horizon": 0}, "horizon"), ({"n_branch": 0}, "N"), ({"max_keep": 0}, "M")):
+        args = {"horizon": 3, "n_branch": 2, "max_keep": 4} | bad
+        with pytest.raises(ValueError, match=f"{name}.*must be >= 1, got 0"):
+            target.sample_tree(np.zeros(4), P, model=model, rng=rng, **args)
+    with pytest.raises(ValueError, match="P_hat must have shape"):
+        target.sample_tree(np.zeros(4), np.eye(3), 3, 2, 4, model, rng)
+
+
 def test_sample_independent_moments():
     """Initial-state draws have mean x_hat and covariance P_hat: with n = 20000 draws the sample
     mean of each coordinate has sd sqrt(P_ii / n); 5 sd (per coordinate) bounds a false failure

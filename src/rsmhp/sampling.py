@@ -78,6 +78,11 @@ class GaussianNoise:
         return self._chol
 
     @property
+    def log_norm(self) -> float:
+        r"""Log normalising constant :math:`-\tfrac d2 \log 2\pi - \sum_i \log L_{ii}`."""
+        return float(self._log_norm)
+
+    @property
     def mean(self) -> np.ndarray:
         """The nominal noise value used by NBO, :math:`\\bar w = 0`, shape (d,)."""
         return np.zeros(self.dim)

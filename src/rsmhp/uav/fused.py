@@ -476,8 +476,11 @@ def cost(
 
 
 def warm_up() -> float:
-    """Compile (or load from the cache) every kernel; returns the seconds it took."""
+    """Compile (or load from the cache) every kernel, the planner's and the hypothesis
+    tree's (:func:`rsmhp.uav.target.sample_tree`); returns the seconds it took."""
     import time
+
+    from rsmhp.uav import target
 
     t0 = time.perf_counter()
     uav = UAVParams(1.0, 9.81, 3.0, 0.7, 10.0, 35.0, 100.0)
@@ -488,4 +491,6 @@ def warm_up() -> float:
     evaluate(np.zeros((1, 4)), frozen, want_grad=False)
     covariance_traces(eye, np.zeros((1, 2, 2)), txy, 1.0, eye, sensor)
     path(np.zeros(4), frozen)
+    model = target.TargetModel(1.0, 1.0)
+    target.sample_tree(np.zeros(4), eye, 1, 2, 1, model, np.random.default_rng(0))
     return time.perf_counter() - t0

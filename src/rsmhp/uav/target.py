@@ -22,6 +22,13 @@ state ``j + 1`` steps ahead. Three generators:
   :math:`\mathcal N(\hat x, \hat P)`, of :math:`w` under :math:`\mathcal N(0, Q)`); a
   trajectory's likeliness is the product, kept as a sum of logs. This is the convention of
   :mod:`rsmhp.sampling`, with the initial-state draw as an extra tree level.
+
+  With shared draws the pruning depends only on the likeliness of the draws, never on the
+  states, so :func:`sample_tree` runs the expansion, pruning and propagation of the kept
+  nodes in one compiled routine (numba, on-disk cache); :func:`sample_tree_reference`, the
+  generic :func:`rsmhp.sampling.sample_tree`, is its test oracle (same random stream, same
+  likeliness values bit for bit, same kept leaves in the same order, states equal up to the
+  rounding of the 4 x 4 product).
 """
 
 from __future__ import annotations
@@ -32,6 +39,7 @@ from functools import cached_property
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from rsmhp.sampling import GaussianNoise, top_m
 from rsmhp.sampling import sample_tree as _sample_tree
@@ -43,6 +51,7 @@ __all__ = [
     "process_noise",
     "sample_independent",
     "sample_tree",
+    "sample_tree_reference",
     "transition_matrix",
 ]
 
@@ -178,6 +187,116 @@ class _Hypotheses:
         return np.zeros(x.shape[0])
 
 
+def _tree_levels(
+    P_hat: np.ndarray, horizon: int, n_branch: int, max_keep: int, model: TargetModel
+) -> list[GaussianNoise]:
+    """Checked arguments; the noise model of every level (H + 1): initial state, then Q."""
+    if horizon < 1:
+        raise ValueError(f"horizon must be >= 1, got {horizon}")
+    if n_branch < 1:
+        raise ValueError(f"N (draws per level) must be >= 1, got {n_branch}")
+    if max_keep < 1:
+        raise ValueError(f"M (trajectories kept) must be >= 1, got {max_keep}")
+    P_hat = np.asarray(P_hat, dtype=float)
+    if P_hat.shape != (4, 4):
+        raise ValueError(f"P_hat must have shape (4, 4), got {P_hat.shape}")
+    return [HypothesisNoise(0.5 * (P_hat + P_hat.T))] + [model.noise] * horizon
+
+
+@njit(cache=True, inline="always")
+def _keep_top(child_ll, max_keep):  # pragma: no cover - compiled
+    """Indices (ascending) of the ``max_keep`` largest entries, ties broken by lower index
+    (the set a stable descending sort would keep); linear time via a partition."""
+    n = child_ll.shape[0]
+    thr = -np.partition(-child_ll, max_keep - 1)[max_keep - 1]  # the max_keep-th largest
+    n_above = 0
+    for c in range(n):
+        if child_ll[c] > thr:
+            n_above += 1
+    room = max_keep - n_above  # entries equal to the threshold still kept, first ones first
+    keep = np.empty(max_keep, dtype=np.int64)
+    r = 0
+    for c in range(n):
+        v = child_ll[c]
+        if v > thr:
+            keep[r] = c
+            r += 1
+        elif v == thr and room > 0:
+            keep[r] = c
+            r += 1
+            room -= 1
+    return keep
+
+
+@njit(cache=True, nogil=True)
+def _pruned_tree_kernel(x_hat, F, z, chols, log_norms, max_keep):  # pragma: no cover
+    """The tree from standard normals ``z`` (L, N, 4): level draws :math:`w = L_k z`, their
+    log-densities by forward substitution (as :class:`HypothesisNoise`), expansion, pruning
+    to the ``max_keep`` most likely (ties by tree order) and propagation of the kept nodes;
+    returns the kept leaves' paths (m, L, 4) in tree order and their log-likeliness (m,)."""
+    n_lv, n_b = z.shape[0], z.shape[1]
+    w = np.empty((n_lv, n_b, 4))
+    ll_w = np.empty((n_lv, n_b))
+    y = np.empty(4)
+    for k in range(n_lv):
+        L = chols[k]
+        for j in range(n_b):
+            for a in range(4):
+                acc = 0.0
+                for b in range(a + 1):
+                    acc += z[k, j, b] * L[a, b]
+                w[k, j, a] = acc
+            quad = 0.0
+            for a in range(4):
+                acc = w[k, j, a]
+                for b in range(a):
+                    acc -= L[a, b] * y[b]
+                y[a] = acc / L[a, a]
+                quad += y[a] * y[a]
+            ll_w[k, j] = log_norms[k] - 0.5 * quad
+    cap = 1
+    for _ in range(n_lv):
+        cap = min(cap * n_b, max_keep)
+    states = np.empty((n_lv, cap, 4))
+    parents = np.empty((n_lv, cap), dtype=np.int64)
+    ll = np.zeros(1)
+    n = 1
+    for k in range(n_lv):
+        n_child = n * n_b
+        child_ll = np.empty(n_child)
+        for i in range(n):
+            for j in range(n_b):
+                child_ll[i * n_b + j] = ll[i] + ll_w[k, j]
+        if n_child > max_keep:
+            keep = _keep_top(child_ll, max_keep)
+        else:
+            keep = np.arange(n_child)
+        m = keep.shape[0]
+        new_ll = np.empty(m)
+        for r in range(m):
+            c = keep[r]
+            i, j = c // n_b, c % n_b
+            parents[k, r] = i
+            new_ll[r] = child_ll[c]
+            for a in range(4):
+                if k == 0:
+                    states[k, r, a] = x_hat[a] + w[k, j, a]
+                else:
+                    acc = 0.0
+                    for b in range(4):
+                        acc += F[a, b] * states[k - 1, i, b]
+                    states[k, r, a] = acc + w[k, j, a]
+        ll = new_ll
+        n = m
+    paths = np.empty((n, n_lv, 4))
+    for r in range(n):
+        node = r
+        for k in range(n_lv - 1, -1, -1):
+            paths[r, k] = states[k, node]
+            node = parents[k, node]
+    return paths, ll
+
+
 def sample_tree(
     x_hat: np.ndarray,
     P_hat: np.ndarray,
@@ -189,15 +308,38 @@ def sample_tree(
 ) -> tuple[np.ndarray, np.ndarray]:
     r"""Pruned tree of hypotheses: ``(states (m, H, 4), log_likeliness (m,))``, ``m <= M``.
 
-    :func:`rsmhp.sampling.sample_tree` with ``H + 1`` levels (paper Fig. 1a, shared draws):
-    level 0 draws ``N`` initial states from :math:`\mathcal N(\hat x, \hat P)`, levels
-    ``1..H`` draw ``N`` process-noise values :math:`w \sim \mathcal N(0, Q)` shared by all
-    nodes; after every level the ``M`` most likely trajectories are kept. Survivors are
-    returned sorted by decreasing likeliness (ties by tree order).
+    The tree of :func:`rsmhp.sampling.sample_tree` with ``H + 1`` levels (paper Fig. 1a,
+    shared draws): level 0 draws ``N`` initial states from :math:`\mathcal N(\hat x, \hat
+    P)`, levels ``1..H`` draw ``N`` process-noise values :math:`w \sim \mathcal N(0, Q)`
+    shared by all nodes; after every level the ``M`` most likely trajectories are kept.
+    Survivors are returned sorted by decreasing likeliness (ties by tree order). Compiled;
+    equal to :func:`sample_tree_reference` (see the module docstring).
     """
-    noise = model.noise
-    system = _Hypotheses(F=model.F, noise=noise)
-    levels = [HypothesisNoise(0.5 * (P_hat + P_hat.T))] + [noise] * horizon
+    levels = _tree_levels(P_hat, horizon, n_branch, max_keep, model)
+    # one call draws the same stream as the reference's level-by-level calls
+    z = rng.standard_normal((horizon + 1, n_branch, 4))
+    chols = np.stack([lv.chol for lv in levels])
+    log_norms = np.array([lv.log_norm for lv in levels])
+    x_hat = np.asarray(x_hat, dtype=float).reshape(4)
+    paths, ll = _pruned_tree_kernel(x_hat, model.F, z, chols, log_norms, int(max_keep))
+    order = top_m(ll, len(ll))
+    # paths[:, 0] is the drawn current state, then H steps ahead
+    return paths[order, 1:], ll[order]
+
+
+def sample_tree_reference(
+    x_hat: np.ndarray,
+    P_hat: np.ndarray,
+    horizon: int,
+    n_branch: int,
+    max_keep: int,
+    model: TargetModel,
+    rng: np.random.Generator,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`sample_tree` through the generic :func:`rsmhp.sampling.sample_tree` (the
+    plain reference implementation, used as the test oracle)."""
+    levels = _tree_levels(P_hat, horizon, n_branch, max_keep, model)
+    system = _Hypotheses(F=model.F, noise=model.noise)
     tree = _sample_tree(
         system,
         np.asarray(x_hat, dtype=float),
