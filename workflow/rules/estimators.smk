@@ -91,7 +91,7 @@ rule estimators_figures:
         "results/benchmarks/estimators_figures.tsv"
     conda:
         ENV
-    threads: 1
+    threads: THREADS
     resources:
         mem_mb=2000,
         runtime=10,

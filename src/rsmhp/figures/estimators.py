@@ -3,20 +3,23 @@
 from __future__ import annotations
 
 from collections.abc import Mapping
+from pathlib import Path
 
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import seaborn as sns
 
-from rsmhp.figures import theme
+from rsmhp.figures import save_figure, theme
 from rsmhp.linear_quadratic import LinearQuadratic
+from rsmhp.parallel import parallel_map
 
 __all__ = [
     "bias_figure",
     "frontier_figure",
     "pruning_heatmap",
     "rmse_figure",
+    "save_all",
     "tree_variance_figure",
     "weighted_vs_uniform_figure",
 ]
@@ -233,3 +236,33 @@ def frontier_figure(s: pd.DataFrame) -> plt.Figure:
     """RMSE vs median CPU seconds per estimate (log-log), every stochastic scheme."""
     title = "Error vs CPU time (quadrature rules are exact here and not shown)"
     return _metric_figure(s, "cpu_median", "rmse", "RMSE", log_y=True, title=title, ci=False)
+
+
+# file stem -> figure function of (summary, problems)
+FIGURES = {
+    "est_rmse_vs_n": lambda s, p: rmse_figure(s),
+    "est_bias_vs_n": lambda s, p: bias_figure(s),
+    "est_tree_variance": tree_variance_figure,
+    "est_weighted_vs_uniform": lambda s, p: weighted_vs_uniform_figure(s),
+    "est_pruning_heatmap": lambda s, p: pruning_heatmap(s),
+    "est_frontier": lambda s, p: frontier_figure(s),
+}
+
+
+def _draw_and_save(job: tuple) -> list[Path]:
+    name, summary, problems, outdir = job
+    return save_figure(FIGURES[name](summary, problems), Path(outdir) / name)
+
+
+def save_all(
+    summary: pd.DataFrame,
+    problems: Mapping[str, LinearQuadratic],
+    outdir: str | Path,
+    n_jobs: int = 1,
+) -> list[Path]:
+    """Draw and save every figure of :data:`FIGURES` (PNG + PDF) in ``outdir``, one process
+    per figure on ``n_jobs`` workers (drawing and rasterising dominate; files do not depend
+    on ``n_jobs``)."""
+    jobs = [(name, summary, problems, str(outdir)) for name in FIGURES]
+    saved = parallel_map(_draw_and_save, jobs, n_jobs, desc="figures")
+    return [path for paths in saved for path in paths]
