@@ -35,6 +35,7 @@ include: "workflow/rules/common.smk"
 include: "workflow/rules/lqg.smk"
 include: "workflow/rules/estimators.smk"
 include: "workflow/rules/uav.smk"
+include: "workflow/rules/decisions.smk"
 include: "workflow/rules/report.smk"
 
 
@@ -44,4 +45,5 @@ rule all:
         rules.lqg.input,
         rules.estimators.input,
         rules.uav.input,
+        rules.decisions.input,
         rules.report.output,

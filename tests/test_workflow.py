@@ -217,3 +217,26 @@ def test_invalid_config_fails_before_any_job(run_j2, tmp_path, override, field):
     assert field in out and "invalid configuration" in out
     assert "Select jobs to execute" not in out and "rule lqg_" not in out
     assert digest(run_j2) == before
+
+
+def test_decision_study_outputs(run_j2, tiny, tmp_path):
+    cfg = tiny["decisions"]["lqg"]
+    df = pd.read_csv(run_j2 / "results/decisions/lqg_regret.csv")
+    assert set(df["a"]) == set(cfg["a_values"]) and set(df["H"]) == set(cfg["H_values"])
+    mc = df[(df.method == "mc") & (df.weighting == "uniform")]
+    assert (
+        len(mc) == len(cfg["a_values"]) * len(cfg["H_values"]) * len(cfg["P"]) * cfg["replicates"]
+    )
+    assert (df["regret"] >= 0).all()
+    assert df.loc[df.method == "nbo", "regret"].max() < 1e-12
+    report = (run_j2 / "paper/replication.md").read_text()
+    for cid in ("DEC-1", "DEC-2", "DEC-3"):
+        assert f"| {cid} |" in report
+    assert "](figures/dec_lqg_regret.png)" in report
+    assert (run_j2 / "paper/figures/dec_lqg_regret.png").exists()
+    # one worker gives the same file (seeds keyed on the cell and replicate, not the worker)
+    res = snakemake(tmp_path, "-j1", "results/decisions/lqg_regret.csv")
+    assert res.returncode == 0, res.stderr[-3000:]
+    assert (tmp_path / "results/decisions/lqg_regret.csv").read_bytes() == (
+        run_j2 / "results/decisions/lqg_regret.csv"
+    ).read_bytes()

@@ -25,6 +25,28 @@ Closed forms (all exact, used as test oracles). Write :math:`b = 1-a` and
   :math:`\phi_\sigma(w)` tilts :math:`\mathcal N(0,\sigma^2)` to :math:`\phi_\sigma^2 \propto
   \mathcal N(0, \sigma^2/2)`, so the weighted average converges to :math:`J` evaluated at
   :math:`\sigma^2/2`, i.e. :math:`J - r v_H / 2` (not to :math:`J`).
+
+Decisions (open-loop controls). :math:`J` is a convex quadratic in :math:`u` with Hessian
+:math:`2A`, :math:`A = I + r a^2 c c^\top`, and :math:`v_H` does not depend on :math:`u`, so
+NBO's cost and the exact cost have the same minimiser (certainty equivalence):
+
+* optimum :math:`u^* = \dfrac{r a (T - b^H x_0)}{1 + r a^2 |c|^2}\, c`
+* regret of any :math:`u`: :math:`J(u) - J(u^*) = (u - u^*)^\top A (u - u^*)`
+* a sample-average cost :math:`\hat J(u) = \sum_i \omega_i r (x_H^i(u) - T)^2 + |u|^2`
+  (noise draws :math:`w^i` held fixed, :math:`\sum_i\omega_i = 1`) is NBO's cost with the
+  target moved to :math:`T - \bar e`, :math:`\bar e = \sum_i \omega_i\, c^\top w^i` (the
+  weighted mean of the sampled final-state noise). Its minimiser is
+  :math:`\hat u = u^* - \dfrac{r a \bar e}{1 + r a^2|c|^2}\, c` and its regret is
+  :math:`\kappa\, \bar e^2` with :math:`\kappa = \dfrac{r^2 a^2 |c|^2}{1 + r a^2 |c|^2}`.
+* hence, for :math:`P` i.i.d. trajectories with uniform weights,
+  :math:`\bar e \sim \mathcal N(0, v_H/P)` and the regret is :math:`\kappa v_H/P` times a
+  :math:`\chi^2_1` variable (mean :math:`\kappa v_H/P`); for the tree with the same
+  :math:`N` draws at every node of a level (uniform weights over its :math:`N^H` leaves) every
+  draw of level :math:`k` appears in the same number of leaves, so
+  :math:`\bar e = \sum_k c_k \bar w_k` with :math:`\bar w_k` the mean of level k's N draws:
+  regret :math:`\kappa v_H/N` times :math:`\chi^2_1`, the regret of only :math:`N`
+  independent trajectories; antithetic pairs and symmetric sigma points give
+  :math:`\bar e = 0`, zero regret.
 """
 
 from __future__ import annotations
@@ -40,9 +62,14 @@ __all__ = [
     "chebyshev_bound",
     "cost_variance",
     "exact_cost",
+    "expected_regret",
     "mhp_variance",
     "nbo_cost",
     "nbo_error",
+    "optimal_controls",
+    "regret",
+    "regret_gain",
+    "sample_argmin",
     "state_mean",
     "state_variance",
     "weighted_limit",
@@ -160,6 +187,88 @@ def weighted_limit(
     r"""Limit (P -> inf) of the likeliness-weighted non-overlapping estimator: :math:`J` at
     noise variance :math:`\sigma^2/2`, i.e. :math:`J - r v_H/2`."""
     return exact_cost(u, x0=x0, a=a, r=r, target=target, sigma=sigma / np.sqrt(2.0))
+
+
+def _coefficients(H: int, a: float) -> np.ndarray:
+    """:math:`c_k = (1-a)^{H-1-k}`, k = 0..H-1: weight of :math:`a u_k + w_k` in :math:`x_H`."""
+    if isinstance(H, bool) or not isinstance(H, int | np.integer) or H < 1:
+        raise ValueError(f"H must be an integer >= 1, got {H!r}")
+    _check(a=a)
+    return (1.0 - a) ** np.arange(H - 1, -1, -1, dtype=float)
+
+
+def optimal_controls(H: int, *, x0: float, a: float, r: float, target: float) -> np.ndarray:
+    r"""Exact open-loop optimum :math:`u^* = \arg\min_u J(u)`, shape (H,):
+    :math:`u^* = r a (T - b^H x_0)\, c / (1 + r a^2 |c|^2)`. NBO's cost has the same
+    minimiser (it differs from J by the constant :math:`r v_H`)."""
+    _check(a=a, r=r)
+    c = _coefficients(H, a)
+    return r * a * (target - (1.0 - a) ** H * x0) * c / (1.0 + r * a * a * np.dot(c, c))
+
+
+def sample_argmin(
+    noise: np.ndarray, weights: np.ndarray, *, x0: float, a: float, r: float, target: float
+) -> np.ndarray:
+    r"""Minimiser (H,) of the sample-average cost with the draws held fixed,
+
+    .. math:: \hat J(u) = \frac{\sum_i \omega_i\, g(u, w^i)}{\sum_i \omega_i},\qquad
+        g(u, w) = r\,(x_H(u, w) - T)^2 + |u|^2,\quad
+        x_H(u, w) = b^H x_0 + a\, c^\top u + c^\top w,
+
+    for noise sequences ``noise`` (n, H) (or (n, H, 1)) and weights ``weights`` (n,) >= 0 with
+    a positive sum (self-normalised: uniform 1/n, quadrature weights and likeliness weights
+    summing to n all fit). With :math:`\bar e = \sum_i \omega_i c^\top w^i / \sum_i
+    \omega_i` the normal equations are :math:`(I + r a^2 c c^\top)\, u = r a (T - b^H x_0 -
+    \bar e)\, c`, solved directly. NBO is the single draw :math:`w = 0`."""
+    _check(a=a, r=r)
+    w = np.asarray(noise, dtype=float)
+    if w.ndim == 3 and w.shape[2] == 1:
+        w = w[:, :, 0]
+    if w.ndim != 2 or w.shape[0] < 1 or w.shape[1] < 1:
+        raise ValueError(f"noise must have shape (n, H) with n, H >= 1, got {np.shape(noise)}")
+    wt = np.asarray(weights, dtype=float)
+    if wt.shape != (w.shape[0],):
+        raise ValueError(f"weights must have shape ({w.shape[0]},), got {wt.shape}")
+    if not (np.all(np.isfinite(w)) and np.all(np.isfinite(wt))):
+        raise ValueError("noise and weights must be finite")
+    if np.any(wt < 0) or not wt.sum() > 0:
+        raise ValueError("weights must be >= 0 with a positive sum")
+    H = w.shape[1]
+    c = _coefficients(H, a)
+    e_bar = float(np.dot(wt, w @ c) / wt.sum())
+    lhs = np.eye(H) + r * a * a * np.outer(c, c)
+    rhs = r * a * (target - (1.0 - a) ** H * x0 - e_bar) * c
+    return np.linalg.solve(lhs, rhs)
+
+
+def regret(u: np.ndarray | list[float], *, x0: float, a: float, r: float, target: float) -> float:
+    r""":math:`J(u) - J(u^*) = (u - u^*)^\top (I + r a^2 c c^\top)(u - u^*) \ge 0` (exact
+    quadratic form, free of the cancellation in a difference of two costs; independent of
+    :math:`\sigma`)."""
+    u = _u(u)
+    c = _coefficients(u.size, a)
+    d = u - optimal_controls(u.size, x0=x0, a=a, r=r, target=target)
+    return float(np.dot(d, d) + r * a * a * np.dot(c, d) ** 2)
+
+
+def regret_gain(H: int, *, a: float, r: float) -> float:
+    r""":math:`\kappa = r^2 a^2 |c|^2 / (1 + r a^2 |c|^2)`: a sample-average argmin whose
+    weighted mean final-state noise is :math:`\bar e` has regret :math:`\kappa\bar e^2`."""
+    _check(a=a, r=r)
+    cc = float(np.dot(c := _coefficients(H, a), c))
+    return r * r * a * a * cc / (1.0 + r * a * a * cc)
+
+
+def expected_regret(n_eff: int | np.ndarray, H: int, *, a: float, r: float, sigma: float):
+    r"""Mean regret :math:`\kappa v_H / n` of a sample-average argmin whose :math:`\bar e`
+    averages ``n_eff`` independent final-state noises with equal weights: n = P for P i.i.d.
+    trajectories, n = N for the shared-draw tree with N draws per level. The regret is this
+    mean times a :math:`\chi^2_1` variable."""
+    n = np.asarray(n_eff)
+    if np.any(n < 1):
+        raise ValueError(f"n_eff must be >= 1, got {n_eff!r}")
+    out = regret_gain(H, a=a, r=r) * state_variance(H, a=a, sigma=sigma) / n
+    return float(out) if np.ndim(out) == 0 else out
 
 
 @dataclass(frozen=True)

@@ -1,0 +1,370 @@
+"""LQG decision study: closed forms of the optimum and the regret, and the simulation
+against them (tolerances from the chi-square variance of the regret)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy import stats
+from scipy.optimize import minimize
+
+from rsmhp import lqg, samplers
+from rsmhp.analysis import decisions as dec
+from rsmhp.experiments.decisions_lqg import (
+    RegretCell,
+    regret_cells,
+    run_lqg_regret,
+    sobol_budget,
+)
+from rsmhp.sampling import rollout_cost, sample_tree
+
+MODEL = {"x0": 0.0, "r": 10.0, "target": 1.0, "sigma": 1.0}
+
+problems = st.fixed_dictionaries(
+    {
+        "H": st.integers(1, 8),
+        "a": st.floats(0.05, 0.95),
+        "r": st.floats(0.1, 100.0),
+        "x0": st.floats(-5.0, 5.0),
+        "target": st.floats(-5.0, 5.0),
+    }
+)
+
+
+def _kw(p):
+    return {k: p[k] for k in ("x0", "a", "r", "target")}
+
+
+@settings(max_examples=40, deadline=None)
+@given(problems)
+def test_optimal_controls_minimise_the_exact_cost(p):
+    kw = _kw(p)
+    u_star = lqg.optimal_controls(p["H"], **kw)
+    j = lambda u: lqg.exact_cost(u, **kw, sigma=1.0)  # noqa: E731
+    res = minimize(j, np.zeros(p["H"]), method="BFGS", options={"gtol": 1e-11})
+    # J is a strictly convex quadratic: the numerical minimiser agrees with the closed form
+    assert j(u_star) <= res.fun + 1e-10 * max(1.0, abs(res.fun))
+    np.testing.assert_allclose(u_star, res.x, atol=1e-5)
+    # NBO's cost has the same minimiser (certainty equivalence)
+    nbo = minimize(lambda u: lqg.nbo_cost(u, **kw), np.zeros(p["H"]), method="BFGS")
+    np.testing.assert_allclose(u_star, nbo.x, atol=1e-5)
+
+
+@settings(max_examples=40, deadline=None)
+@given(problems, st.integers(0, 2**32 - 1))
+def test_regret_is_the_exact_cost_difference(p, seed):
+    kw = _kw(p)
+    u = np.random.default_rng(seed).normal(0.0, 2.0, p["H"])
+    diff = lqg.exact_cost(u, **kw, sigma=0.7) - lqg.exact_cost(
+        lqg.optimal_controls(p["H"], **kw), **kw, sigma=0.7
+    )
+    reg = lqg.regret(u, **kw)
+    assert reg >= 0.0
+    assert reg == pytest.approx(diff, rel=1e-9, abs=1e-9 * lqg.exact_cost(u, **kw, sigma=0.7))
+
+
+@settings(max_examples=30, deadline=None)
+@given(problems, st.integers(1, 50), st.booleans(), st.integers(0, 2**32 - 1))
+def test_sample_argmin_minimises_the_library_sample_cost(p, n, weighted, seed):
+    """The argmin of the estimator's own arithmetic (rollout_cost on LQGModel, weighted
+    average): zero gradient by exact central differences of the quadratic, no better point
+    nearby, regret = kappa * e_bar^2."""
+    rng = np.random.default_rng(seed)
+    kw = _kw(p)
+    H = p["H"]
+    model = lqg.LQGModel(a=p["a"], r=p["r"], target=p["target"], sigma=1.3)
+    noise = rng.normal(0.0, 1.3, (n, H, 1))
+    omega = rng.uniform(0.1, 2.0, n) if weighted else np.full(n, 1.0 / n)
+
+    def j_hat(u):
+        return float(omega @ rollout_cost(model, [p["x0"]], u, noise) / omega.sum())
+
+    u_hat = lqg.sample_argmin(noise, omega, **kw)
+    scale = max(1.0, j_hat(u_hat))
+    for k in range(H):
+        step = np.zeros(H)
+        step[k] = 1e-3
+        grad_k = (j_hat(u_hat + step) - j_hat(u_hat - step)) / 2e-3
+        assert abs(grad_k) <= 1e-7 * scale / 1e-3
+    for _ in range(5):
+        assert j_hat(u_hat + rng.normal(0.0, 0.05, H)) >= j_hat(u_hat) - 1e-12 * scale
+    c = (1.0 - p["a"]) ** np.arange(H - 1, -1, -1)
+    e_bar = float(omega @ (noise[:, :, 0] @ c) / omega.sum())
+    expected = lqg.regret_gain(H, a=p["a"], r=p["r"]) * e_bar**2
+    assert lqg.regret(u_hat, **kw) == pytest.approx(expected, rel=1e-8, abs=1e-14)
+
+
+def test_nbo_antithetic_and_cubature_have_zero_regret():
+    kw = {"x0": 0.3, "a": 0.5, "r": 10.0, "target": 1.0}
+    H = 4
+    rng = np.random.default_rng(1)
+    chol = np.array([[1.0]])
+    j_star = lqg.exact_cost(lqg.optimal_controls(H, **kw), **kw, sigma=1.0)
+    nbo = lqg.sample_argmin(np.zeros((1, H)), np.ones(1), **kw)
+    anti, wa = samplers.antithetic(rng, 100, H, chol)
+    cub, wc = samplers.cubature(H, chol)
+    for noise, w in ((np.zeros((1, H)), np.ones(1)), (anti, wa), (cub, wc)):
+        assert lqg.regret(lqg.sample_argmin(noise, w, **kw), **kw) <= 1e-24 * j_star
+    np.testing.assert_allclose(nbo, lqg.optimal_controls(H, **kw), rtol=1e-14)
+
+
+def test_sample_argmin_rejects_bad_input():
+    kw = {"x0": 0.0, "a": 0.5, "r": 1.0, "target": 1.0}
+    with pytest.raises(ValueError, match="weights must have shape"):
+        lqg.sample_argmin(np.zeros((3, 2)), np.ones(2), **kw)
+    with pytest.raises(ValueError, match="positive sum"):
+        lqg.sample_argmin(np.zeros((3, 2)), np.zeros(3), **kw)
+    with pytest.raises(ValueError, match="finite"):
+        lqg.sample_argmin(np.full((3, 2), np.nan), np.ones(3), **kw)
+    with pytest.raises(ValueError, match="shape"):
+        lqg.sample_argmin(np.zeros(3), np.ones(3), **kw)
+    with pytest.raises(ValueError, match="H must be an integer"):
+        lqg.optimal_controls(2.5, **kw)
+    with pytest.raises(ValueError, match="n_eff"):
+        lqg.expected_regret(0, 2, a=0.5, r=1.0, sigma=1.0)
+
+
+def _chi2_check(regrets: np.ndarray, mean: float) -> None:
+    """Regret = mean * chi2_1: the sample mean within 4 standard errors (sd of chi2_1 is
+    sqrt(2)), and a KS test against the scaled chi2_1 law."""
+    R = regrets.size
+    z = (regrets.mean() - mean) / (mean * np.sqrt(2.0 / R))
+    assert abs(z) < 4.0, z
+    assert stats.kstest(regrets / mean, stats.chi2(1).cdf).pvalue > 1e-3
+
+
+@pytest.mark.parametrize("P", [3, 40])
+def test_mc_regret_is_scaled_chi_square(P):
+    a, H, R = 0.4, 3, 3000
+    kw = {"x0": 0.0, "a": a, "r": 5.0, "target": 2.0}
+    rng = np.random.default_rng(P)
+    chol = np.array([[0.8]])
+    reg = np.array(
+        [
+            lqg.regret(lqg.sample_argmin(*samplers.monte_carlo(rng, P, H, chol), **kw), **kw)
+            for _ in range(R)
+        ]
+    )
+    _chi2_check(reg, lqg.expected_regret(P, H, a=a, r=5.0, sigma=0.8))
+
+
+def test_shared_draw_tree_regret_is_that_of_n_trajectories():
+    """Uniform average over the N^H leaves: e_bar is exactly sum_k c_k (mean of level k's N
+    draws), so the regret is kappa v_H / N times chi2_1, not kappa v_H / N^H."""
+    a, H, N, R = 0.5, 3, 4, 2000
+    kw = {"x0": 0.0, "a": a, "r": 10.0, "target": 1.0}
+    model = lqg.LQGModel(a=a, r=10.0, target=1.0, sigma=1.0)
+    c = (1.0 - a) ** np.arange(H - 1, -1, -1)
+    rng = np.random.default_rng(7)
+    reg = np.empty(R)
+    for i in range(R):
+        state = rng.bit_generator.state
+        leaves = sample_tree(model, [0.0], np.zeros(H), N, rng).leaves
+        rng2 = np.random.default_rng()
+        rng2.bit_generator.state = state
+        level_means = [rng2.standard_normal(N).mean() for _ in range(H)]
+        noise = leaves.noise[:, :, 0]
+        assert noise.shape == (N**H, H)
+        np.testing.assert_allclose(noise.mean(axis=0) @ c, np.dot(c, level_means), atol=1e-13)
+        reg[i] = lqg.regret(lqg.sample_argmin(noise, np.full(N**H, N ** -float(H)), **kw), **kw)
+    _chi2_check(reg, lqg.expected_regret(N, H, a=a, r=10.0, sigma=1.0))
+
+
+def test_sobol_budget_and_cells():
+    assert [sobol_budget(p) for p in (10, 30, 100, 300, 1000, 3000, 10000)] == [
+        8,
+        32,
+        128,
+        256,
+        1024,
+        4096,
+        8192,
+    ]
+    cfg = {
+        "a_values": [0.5],
+        "H_values": [2, 4],
+        "P": [10, 100],
+        "tree_N": [2, 10, 100],
+        "pruned_N": 10,
+        "max_leaves": 10000,
+        "replicates": 3,
+        "methods": ["nbo", "mc", "antithetic", "sobol", "cubature", "tree", "pruned"],
+    }
+    cells = regret_cells(cfg)
+    trees = [(c.H, c.N) for c in cells if c.method == "tree"]
+    assert trees == [(2, 2), (2, 10), (2, 100), (4, 2), (4, 10)]  # N^H <= max_leaves
+    pruned = [(c.H, c.M) for c in cells if c.method == "pruned"]
+    assert pruned == [(2, 10), (4, 10), (4, 100)]  # only M < N^H prunes
+    assert RegretCell(0.5, 4, "cubature", P=8) in cells
+    with pytest.raises(ValueError, match="unknown method 'bogus'"):
+        regret_cells({**cfg, "methods": ["bogus"]})
+
+
+def test_run_is_deterministic_and_complete():
+    cfg = {
+        "a_values": [0.3, 0.7],
+        "H_values": [2, 3],
+        "P": [10, 30],
+        "tree_N": [2, 3],
+        "pruned_N": 4,
+        "max_leaves": 100,
+        "replicates": 4,
+        "methods": ["nbo", "mc", "antithetic", "sobol", "cubature", "tree", "pruned"],
+    }
+    one = run_lqg_regret(cfg, MODEL, 11, n_jobs=1)
+    two = run_lqg_regret(cfg, MODEL, 11, n_jobs=2)
+    assert one.equals(two)
+    assert list(one.columns[:10]) == [
+        "problem",
+        "a",
+        "H",
+        "method",
+        "weighting",
+        "N",
+        "M",
+        "P",
+        "replicate",
+        "regret",
+    ]
+    assert {"u_hat_0", "u_hat_1", "u_hat_2"} <= set(one.columns)
+    assert one.loc[one.H == 2, "u_hat_2"].isna().all()
+    assert (one.regret >= 0).all()
+    counts = one.groupby(["a", "H", "method", "weighting", "N", "M", "P"]).size()
+    det = counts.index.get_level_values("method").isin(["nbo", "cubature"])
+    assert (counts[det] == 1).all() and (counts[~det] == 4).all()
+    # weighted rows exist exactly for mc, tree, pruned
+    assert set(one.loc[one.weighting == "likeliness", "method"]) == {"mc", "tree", "pruned"}
+    # the argmin in the row reproduces the row's regret
+    row = one[(one.method == "mc") & (one.H == 3)].iloc[0]
+    u = row[["u_hat_0", "u_hat_1", "u_hat_2"]].to_numpy(float)
+    kw = {"x0": 0.0, "a": row.a, "r": 10.0, "target": 1.0}
+    assert lqg.regret(u, **kw) == pytest.approx(row.regret, rel=1e-12)
+    # a different seed gives different draws
+    assert not run_lqg_regret(cfg, MODEL, 12, n_jobs=1).regret.equals(one.regret)
+
+
+# ------------------------------------------------------------------ aggregation and claims
+
+
+def _synthetic(nbo_regret: float, pruned_slope: float, seed: int = 3) -> pd.DataFrame:
+    """Regret rows drawn from the closed forms (chi2_1 laws) for a small grid; the pruned
+    tree's mean follows M^pruned_slope."""
+    rng = np.random.default_rng(seed)
+    rows = []
+    R = 400
+    for a in (0.4, 0.6):
+        for H in (2, 4):
+            base = {"problem": f"p{a}{H}", "a": a, "H": H, "replicate": 0, "shift": 0.0}
+            rows.append(
+                {
+                    **base,
+                    "method": "nbo",
+                    "weighting": "uniform",
+                    "N": 0,
+                    "M": 0,
+                    "P": 1,
+                    "regret": nbo_regret,
+                }
+            )
+            for P in (10, 100, 1000):
+                mean = lqg.expected_regret(P, H, a=a, r=MODEL["r"], sigma=MODEL["sigma"])
+                for r, x in enumerate(mean * rng.chisquare(1, R)):
+                    rows.append(
+                        {
+                            **base,
+                            "method": "mc",
+                            "weighting": "uniform",
+                            "N": 0,
+                            "M": 0,
+                            "P": P,
+                            "replicate": r,
+                            "regret": x,
+                        }
+                    )
+                for r, x in enumerate(0.2 * (P / 10) ** pruned_slope * rng.chisquare(1, R)):
+                    rows.append(
+                        {
+                            **base,
+                            "method": "pruned",
+                            "weighting": "uniform",
+                            "N": 10,
+                            "M": P,
+                            "P": P,
+                            "replicate": r,
+                            "regret": x,
+                        }
+                    )
+            for N in (2, 4, 8):
+                if N**H > 5000:
+                    continue
+                mean = lqg.expected_regret(N, H, a=a, r=MODEL["r"], sigma=MODEL["sigma"])
+                for r, x in enumerate(mean * rng.chisquare(1, R)):
+                    rows.append(
+                        {
+                            **base,
+                            "method": "tree",
+                            "weighting": "uniform",
+                            "N": N,
+                            "M": 0,
+                            "P": N**H,
+                            "replicate": r,
+                            "regret": x,
+                        }
+                    )
+    return pd.DataFrame(rows)
+
+
+def _verdicts(df: pd.DataFrame) -> dict[str, str]:
+    summary = dec.summarize_lqg_regret(df, MODEL)
+    scaling = dec.lqg_scaling(summary)
+    return {c.id: c.verdict for c in dec.lqg_claims(summary, scaling, MODEL)}
+
+
+def test_claims_follow_their_rules():
+    v = _verdicts(_synthetic(nbo_regret=0.0, pruned_slope=0.0))
+    assert v["DEC-1"] == "not supported"  # NBO optimal
+    assert v["DEC-2"] == "supported"  # chi2 draws with the closed-form mean
+    assert v["DEC-3"] == "supported"
+    assert v["DEC-4"] == "not supported"  # flat in M
+    v = _verdicts(_synthetic(nbo_regret=1.0, pruned_slope=-1.0))
+    assert v["DEC-1"] == "supported"  # 1.0 is far above 1% of J*
+    assert v["DEC-4"] == "supported"
+
+
+def test_a_wrong_closed_form_is_detected():
+    df = _synthetic(nbo_regret=0.0, pruned_slope=0.0)
+    df.loc[df.method == "tree", "regret"] *= 1.5  # 50% off the closed form
+    assert _verdicts(df)["DEC-3"] == "not supported"
+
+
+def test_summary_z_scores_and_tables():
+    df = _synthetic(nbo_regret=0.0, pruned_slope=0.0)
+    summary = dec.summarize_lqg_regret(df, MODEL)
+    exact = summary[summary.closed_kind == "exact"]
+    assert (exact.loc[exact.method == "mc", "z"].abs() < 4).all()
+    j_star = lqg.exact_cost(
+        lqg.optimal_controls(2, x0=0.0, a=0.4, r=10.0, target=1.0),
+        x0=0.0,
+        a=0.4,
+        r=10.0,
+        target=1.0,
+        sigma=1.0,
+    )
+    assert summary.loc[(summary.a == 0.4) & (summary.H == 2), "J_star"].iloc[0] == pytest.approx(
+        j_star
+    )
+    tables = dec.lqg_tables(summary, dec.lqg_scaling(summary))
+    assert "nan" not in tables["dec_lqg_regret"]
+    section = dec.lqg_decision_section(
+        summary,
+        dec.lqg_scaling(summary),
+        tables,
+        MODEL,
+        {"replicates": 400, "a_values": [0.4, 0.6], "H_values": [2, 4]},
+    )
+    assert [c.id for c in section.claims] == ["DEC-1", "DEC-2", "DEC-3", "DEC-4"]
+    for rule in dec.LQG_RULES.values():
+        assert rule in section.body
