@@ -25,13 +25,17 @@ with the closed-form 2x2 inverse :math:`S^{-1} = \mathrm{adj}(S)/\det S`. The 10
 entries of P are carried as arrays of shape (C, T); only upper triangles of the symmetric
 blocks are formed, so symmetry holds exactly. The form :math:`P^- - K S K^T` (not Joseph)
 is used; it agrees with filterpy's Joseph form to rounding error.
+
+With a sensor footprint (:class:`rsmhp.uav.sensor.SensorModel`) the update is the expected
+one, :math:`P^+ = P^- - p_d\, K S K^T` with :math:`p_d = p_d(\mathrm{uav}_{c,j},
+\mathrm{target}_{i,j})`: :math:`p_d = 0` is a prediction only (no measurement).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from rsmhp.uav.sensor import SensorModel, measurement_cov_entries
+from rsmhp.uav.sensor import SensorModel, detection_probability, measurement_cov_entries
 
 __all__ = ["covariance_traces", "objective"]
 
@@ -68,6 +72,12 @@ def covariance_traces(
     dt2 = dt * dt
     # R for every (candidate, hypothesis, step): (C, T, H) each
     rxx, rxy, ryy = measurement_cov_entries(uav_xy[:, None, :, :], target_xy[None, :, :, :], sensor)
+    # expected-update factor (C, T, H); None: every step measures (the paper's model)
+    pd = (
+        detection_probability(uav_xy[:, None, :, :], target_xy[None, :, :, :], sensor)
+        if sensor.limited
+        else None
+    )
     traces = np.empty((n_c, n_t, horizon))
     covs = np.empty((n_c, n_t, horizon, 4, 4)) if return_cov else None
     for j in range(horizon):
@@ -96,16 +106,29 @@ def covariance_traces(
         n21 = i12 * pb11 + i22 * pb21
         n22 = i12 * pb12 + i22 * pb22
         # update: A+ = A- - A- M, B+ = B- - A- N, C+ = C- - B-^T N
-        a11 = pa11 - (pa11 * m11 + pa12 * m21)
-        a12 = pa12 - (pa11 * m12 + pa12 * m22)
-        a22 = pa22 - (pa12 * m12 + pa22 * m22)
-        b11 = pb11 - (pa11 * n11 + pa12 * n21)
-        b12 = pb12 - (pa11 * n12 + pa12 * n22)
-        b21 = pb21 - (pa12 * n11 + pa22 * n21)
-        b22 = pb22 - (pa12 * n12 + pa22 * n22)
-        c11 = pc11 - (pb11 * n11 + pb21 * n21)
-        c12 = pc12 - (pb11 * n12 + pb21 * n22)
-        c22 = pc22 - (pb12 * n12 + pb22 * n22)
+        if pd is None:
+            a11 = pa11 - (pa11 * m11 + pa12 * m21)
+            a12 = pa12 - (pa11 * m12 + pa12 * m22)
+            a22 = pa22 - (pa12 * m12 + pa22 * m22)
+            b11 = pb11 - (pa11 * n11 + pa12 * n21)
+            b12 = pb12 - (pa11 * n12 + pa12 * n22)
+            b21 = pb21 - (pa12 * n11 + pa22 * n21)
+            b22 = pb22 - (pa12 * n12 + pa22 * n22)
+            c11 = pc11 - (pb11 * n11 + pb21 * n21)
+            c12 = pc12 - (pb11 * n12 + pb21 * n22)
+            c22 = pc22 - (pb12 * n12 + pb22 * n22)
+        else:  # expected update P- - p_d K S K^T
+            p = pd[:, :, j]
+            a11 = pa11 - p * (pa11 * m11 + pa12 * m21)
+            a12 = pa12 - p * (pa11 * m12 + pa12 * m22)
+            a22 = pa22 - p * (pa12 * m12 + pa22 * m22)
+            b11 = pb11 - p * (pa11 * n11 + pa12 * n21)
+            b12 = pb12 - p * (pa11 * n12 + pa12 * n22)
+            b21 = pb21 - p * (pa12 * n11 + pa22 * n21)
+            b22 = pb22 - p * (pa12 * n12 + pa22 * n22)
+            c11 = pc11 - p * (pb11 * n11 + pb21 * n21)
+            c12 = pc12 - p * (pb11 * n12 + pb21 * n22)
+            c22 = pc22 - p * (pb12 * n12 + pb22 * n22)
         traces[:, :, j] = a11 + a22 + c11 + c22
         if covs is not None:
             rows = (

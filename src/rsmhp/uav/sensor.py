@@ -19,6 +19,21 @@ where :math:`G` is the rotation by the horizontal bearing :math:`\beta` from UAV
 with :math:`c = \cos\beta, s = \sin\beta`. Directly overhead (:math:`\rho = 0`) the bearing is
 undefined and we take :math:`\beta = 0`; since :math:`d \ge h > 0`,
 :math:`\det R = f_r^2 f_c^2 d^4 > 0`: R is never singular.
+
+Model variants (beyond the paper's model; the defaults reproduce it exactly):
+
+* **noise growth** ``quadratic``: :math:`\sigma_r = f_r d^2 / d_0`, :math:`\sigma_c = f_c d^2 /
+  d_0` (equal to the linear model at the reference distance :math:`d_0`), i.e. the factor
+  :math:`d^2` in R becomes :math:`d^4 / d_0^2`.
+* **footprint**: a horizontal radius :math:`\rho_0` outside which the sensor sees nothing.
+  The truth simulation (``detection``) either detects exactly when :math:`\rho \le \rho_0`
+  (``hard``) or with probability :math:`p_d(\rho)` (``logistic``). The planner always uses
+  the smooth detection probability
+  :math:`p_d(\rho) = 1 / (1 + e^{(\rho - \rho_0)/w})` (width w in m) and the expected
+  update :math:`P^+ = P^- - p_d\, K S K^T` (:mod:`rsmhp.uav.kernel`): exact for the expected
+  covariance of one step, and differentiable in the UAV position, whereas a hard footprint
+  makes every hypothesis's cost a step function of the controls (zero gradient almost
+  everywhere). Without a footprint (:math:`\rho_0 = \infty`) :math:`p_d = 1`.
 """
 
 from __future__ import annotations
@@ -29,23 +44,77 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["SensorModel", "measurement_cov", "measurement_cov_entries", "measurement_noise"]
+__all__ = [
+    "GROWTHS",
+    "SensorModel",
+    "detected",
+    "detection_probability",
+    "measurement_cov",
+    "measurement_cov_entries",
+    "measurement_noise",
+]
+
+GROWTHS = ("linear", "quadratic")
+DETECTIONS = ("hard", "logistic")
 
 
 @dataclass(frozen=True)
 class SensorModel:
-    """Noise fractions ``f_r``, ``f_c`` (per metre of distance) and UAV altitude ``h`` (m)."""
+    """Noise fractions ``f_r``, ``f_c`` (per metre of distance) and UAV altitude ``h`` (m);
+    optional variants: noise growth (``linear`` or ``quadratic`` with reference distance
+    ``reference_distance`` :math:`d_0`, m), footprint radius :math:`\rho_0` (m, ``inf`` =
+    unlimited) with planner width ``footprint_width`` w (m) and truth ``detection`` model."""
 
     sigma_r_per_m: float
     sigma_c_per_m: float
     altitude: float
+    noise_growth: str = "linear"
+    reference_distance: float = 100.0
+    footprint_radius: float = float("inf")
+    footprint_width: float = 10.0
+    detection: str = "hard"
+
+    def __post_init__(self) -> None:
+        for name in ("sigma_r_per_m", "sigma_c_per_m", "altitude", "reference_distance"):
+            value = getattr(self, name)
+            if not (np.isfinite(value) and value > 0):
+                raise ValueError(f"SensorModel.{name} must be finite and > 0, got {value!r}")
+        if self.noise_growth not in GROWTHS:
+            raise ValueError(
+                f"SensorModel.noise_growth must be one of {GROWTHS}, got {self.noise_growth!r}"
+            )
+        if self.detection not in DETECTIONS:
+            raise ValueError(
+                f"SensorModel.detection must be one of {DETECTIONS}, got {self.detection!r}"
+            )
+        if not self.footprint_radius > 0 or np.isnan(self.footprint_radius):
+            raise ValueError(
+                f"SensorModel.footprint_radius must be > 0 (inf: unlimited), "
+                f"got {self.footprint_radius!r}"
+            )
+        if not (np.isfinite(self.footprint_width) and self.footprint_width > 0):
+            raise ValueError(
+                f"SensorModel.footprint_width must be finite and > 0, got {self.footprint_width!r}"
+            )
+
+    @property
+    def limited(self) -> bool:
+        """Whether the sensor has a finite footprint."""
+        return bool(np.isfinite(self.footprint_radius))
 
     @classmethod
     def from_config(cls, uav: Mapping[str, Any]) -> SensorModel:
+        sen = uav["sensor"]
+        radius = sen.get("footprint_radius")
         return cls(
-            sigma_r_per_m=float(uav["sensor"]["sigma_r_per_m"]),
-            sigma_c_per_m=float(uav["sensor"]["sigma_c_per_m"]),
+            sigma_r_per_m=float(sen["sigma_r_per_m"]),
+            sigma_c_per_m=float(sen["sigma_c_per_m"]),
             altitude=float(uav["aircraft"]["altitude"]),
+            noise_growth=str(sen.get("noise_growth", "linear")),
+            reference_distance=float(sen.get("reference_distance", 100.0)),
+            footprint_radius=float("inf") if radius is None else float(radius),
+            footprint_width=float(sen.get("footprint_width", 10.0)),
+            detection=str(sen.get("detection", "hard")),
         )
 
 
@@ -69,6 +138,8 @@ def measurement_cov_entries(
     ``target_xy[..., 0]`` (m²)."""
     d2, c, s = _geometry(np.asarray(uav_xy), np.asarray(target_xy), sensor.altitude)
     fr2, fc2 = sensor.sigma_r_per_m**2, sensor.sigma_c_per_m**2
+    if sensor.noise_growth == "quadratic":
+        d2 = d2 * d2 / sensor.reference_distance**2  # the factor d^2 of R becomes d^4 / d0^2
     rxx = d2 * (fr2 * c * c + fc2 * s * s)
     rxy = d2 * (fr2 - fc2) * c * s
     ryy = d2 * (fr2 * s * s + fc2 * c * c)
@@ -92,6 +163,32 @@ def measurement_noise(
     """
     d2, c, s = _geometry(np.asarray(uav_xy), np.asarray(target_xy), sensor.altitude)
     d = np.sqrt(d2)
+    if sensor.noise_growth == "quadratic":
+        d = d2 / sensor.reference_distance
     sr, sc = sensor.sigma_r_per_m * d, sensor.sigma_c_per_m * d
     zr, zc = std_normal[..., 0] * sr, std_normal[..., 1] * sc
     return np.stack([c * zr - s * zc, s * zr + c * zc], axis=-1)
+
+
+def detection_probability(
+    uav_xy: np.ndarray, target_xy: np.ndarray, sensor: SensorModel
+) -> np.ndarray:
+    r"""The planner's :math:`p_d = 1/(1 + e^{(\rho - \rho_0)/w})` (broadcast shape of the
+    positions' leading axes); 1 without a footprint."""
+    uav_xy, target_xy = np.asarray(uav_xy, dtype=float), np.asarray(target_xy, dtype=float)
+    rho = np.hypot(target_xy[..., 0] - uav_xy[..., 0], target_xy[..., 1] - uav_xy[..., 1])
+    if not sensor.limited:
+        return np.ones_like(rho)
+    with np.errstate(over="ignore"):
+        return 1.0 / (1.0 + np.exp((rho - sensor.footprint_radius) / sensor.footprint_width))
+
+
+def detected(uav_xy: np.ndarray, target_xy: np.ndarray, sensor: SensorModel, u: float) -> bool:
+    """Whether the truth simulation gets a measurement: always without a footprint; with one,
+    ``rho <= rho_0`` (``hard``) or ``u < p_d(rho)`` for a uniform ``u`` (``logistic``)."""
+    if not sensor.limited:
+        return True
+    if sensor.detection == "hard":
+        rho = float(np.hypot(target_xy[0] - uav_xy[0], target_xy[1] - uav_xy[1]))
+        return rho <= sensor.footprint_radius
+    return bool(u < float(detection_probability(uav_xy, target_xy, sensor)))

@@ -11,6 +11,11 @@ Run ``r`` (paired design: identical for every method)
 * **Truth process noise** :math:`w_1..w_K \sim \mathcal N(0, Q)` from
   ``job_rng(seed, "uav_process_noise", run=r)`` as one (K, 4) standard-normal block times
   :math:`\mathrm{chol}(Q)^T`.
+* **Detections** (only with a sensor footprint, :mod:`rsmhp.uav.sensor`): uniforms
+  :math:`u_1..u_K` from ``job_rng(seed, "uav_detection", run=r)``; step k measures if the
+  true horizontal distance is within the footprint (``hard``) or if :math:`u_k < p_d`
+  (``logistic``); otherwise the tracker only predicts. Without a footprint nothing is drawn
+  and every step measures (the paper's model).
 * **Measurement noise**: standard normals :math:`\zeta_1..\zeta_K` (K, 2) from
   ``job_rng(seed, "uav_measurement_noise", run=r)``; the noise at step k is
   :math:`v_k = G_k \mathrm{diag}(\sigma_r, \sigma_c)_k \zeta_k` with the *true* geometry of the
@@ -202,6 +207,9 @@ def _simulate_run(setup, method, seed, run, observer):
     w = job_rng(seed, "uav_process_noise", run=run).standard_normal((K, 4))
     w = w @ np.linalg.cholesky(setup.target.Q).T
     zeta = job_rng(seed, "uav_measurement_noise", run=run).standard_normal((K, 2))
+    limited = setup.sensor.limited
+    det_u = job_rng(seed, "uav_detection", run=run).random(K) if limited else np.zeros(K)
+    n_detected = 0
     F = setup.target.F
     x_true, uav_state = sc.target.copy(), sc.uav.copy()
     trk = Tracker(sc.estimate, setup.P0, setup.target)
@@ -222,9 +230,12 @@ def _simulate_run(setup, method, seed, run, observer):
         uav_state = kinematics.step(uav_state, res.controls[0], setup.uav)
         x_true = F @ x_true + w[k - 1]
         trk.predict()
-        R_est = sensor.measurement_cov(uav_state[:2], trk.x[:2], setup.sensor)
-        v = sensor.measurement_noise(uav_state[:2], x_true[:2], setup.sensor, zeta[k - 1])
-        trk.update(x_true[:2] + v, R_est)
+        seen = sensor.detected(uav_state[:2], x_true[:2], setup.sensor, det_u[k - 1])
+        if seen:
+            R_est = sensor.measurement_cov(uav_state[:2], trk.x[:2], setup.sensor)
+            v = sensor.measurement_noise(uav_state[:2], x_true[:2], setup.sensor, zeta[k - 1])
+            trk.update(x_true[:2] + v, R_est)
+            n_detected += 1
         x_est, P_est = trk.x, trk.P
         err = float(np.hypot(*(x_est[:2] - x_true[:2])))
         tr = float(np.trace(P_est))
@@ -249,6 +260,8 @@ def _simulate_run(setup, method, seed, run, observer):
                 "kernel_calls": res.n_kernel_calls,
             }
         )
+        if limited:  # variant-only column: the paper's model's outputs stay as they were
+            rows[-1]["detected"] = bool(seen)
         if observer is not None:
             observer(StepInfo(k, uav_state, x_true, x_est, P_est, res.uav_path, hyp, err, tr))
     errors = np.array([r["error"] for r in rows])
@@ -267,4 +280,6 @@ def _simulate_run(setup, method, seed, run, observer):
         "mean_nit": float(np.mean([r["nit"] for r in rows])),
         "plan_seconds": plan_seconds,
     }
+    if limited:
+        summary["detect_rate"] = n_detected / K
     return summary, rows
