@@ -240,3 +240,25 @@ def test_decision_study_outputs(run_j2, tiny, tmp_path):
     assert (tmp_path / "results/decisions/lqg_regret.csv").read_bytes() == (
         run_j2 / "results/decisions/lqg_regret.csv"
     ).read_bytes()
+
+
+def test_uav_decision_outputs(run_j2, tiny):
+    cfg = tiny["decisions"]
+    regret = pd.read_csv(run_j2 / "results/decisions/uav_regret.csv")
+    n_states = cfg["uav"]["runs"] * len(cfg["uav"]["steps"]) * len(cfg["uav"]["models"])
+    n_methods = 1 + len(cfg["uav"]["methods"]["rsmhp_nt"]) + len(cfg["uav"]["methods"]["tree"])
+    assert len(regret) == n_states * n_methods
+    assert (regret["regret"] >= -1e-9 * regret["best_cost"]).all()
+    map_df = pd.read_csv(run_j2 / "results/decisions/uav_map.csv")
+    n_cells = len(cfg["map"]["rows"]["values"]) * len(cfg["map"]["cols"]["values"])
+    assert len(map_df) == n_cells * len(cfg["map"]["methods"]["rsmhp_nt"])
+    assert (map_df["n_runs"] == cfg["map"]["runs"]).all()
+    for cell in ("r0c0", "r1c1"):
+        runs = pd.read_csv(run_j2 / f"results/decisions/map/{cell}.csv")
+        assert len(runs) == cfg["map"]["runs"] * 2
+        assert (run_j2 / f"results/benchmarks/decisions_map_cell/{cell}.tsv").exists()
+    report = (run_j2 / "paper/replication.md").read_text()
+    for cid in ("DEC-6", "DEC-8a", "DEC-8b"):
+        assert f"| {cid} |" in report
+    for name in ("dec_uav_regret", "dec_uav_map"):
+        assert (run_j2 / f"paper/figures/{name}.png").exists()

@@ -111,6 +111,69 @@ def _cross_field(config: Mapping[str, Any]) -> list[str]:
         if isinstance(val, float) and not math.isfinite(val):
             problems.append(f"lqg.model.{key}: {val} is not finite")
     problems += _uav_cross_field(config.get("uav", {}) or {})
+    problems += _decisions_cross_field(config)
+    return problems
+
+
+def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
+    """Belief-state steps inside a run, map axes with values their key allows, a method to
+    compare, unique model names."""
+    problems: list[str] = []
+    dec = config.get("decisions", {}) or {}
+    n_steps = ((config.get("uav", {}) or {}).get("scenario", {}) or {}).get("steps", 60)
+    for path, steps in (
+        ("decisions.uav.steps", (dec.get("uav", {}) or {}).get("steps", [])),
+        ("decisions.map.regret_steps", (dec.get("map", {}) or {}).get("regret_steps", [])),
+    ):
+        late = [s for s in steps or [] if isinstance(s, int) and s >= n_steps]
+        if late:
+            problems.append(
+                f"{path}: {late} not before the run's last step (allowed: 0 <= step < "
+                f"uav.scenario.steps = {n_steps})"
+            )
+    names = [m.get("name") for m in (dec.get("uav", {}) or {}).get("models", []) or []]
+    dup = sorted({n for n in names if names.count(n) > 1})
+    if dup:
+        problems.append(f"decisions.uav.models: duplicate name(s) {dup} (allowed: unique names)")
+    for section in ("uav", "map"):
+        methods = (dec.get(section, {}) or {}).get("methods")
+        if isinstance(methods, Mapping) and methods:
+            n = bool(methods.get("nbo", True)) + len(methods.get("rsmhp_nt", []) or [])
+            n += len(methods.get("tree", []) or [])
+            if n < 2 and section == "map":
+                problems.append(
+                    "decisions.map.methods: fewer than 2 methods (allowed: NBO and at least "
+                    "one RS-MHP N_T or tree, to compare)"
+                )
+            if n < 1:
+                problems.append(f"decisions.{section}.methods: no method (allowed: at least 1)")
+    rec = (dec.get("recording", {}) or {}).get("model")
+    if rec is not None and names and rec not in names:
+        problems.append(
+            f"decisions.recording.model: {rec!r} is not a model of decisions.uav.models "
+            f"(allowed: {', '.join(map(str, names))})"
+        )
+    mp = dec.get("map", {}) or {}
+    keys = []
+    for axis in ("rows", "cols"):
+        ax = mp.get(axis) or {}
+        key = ax.get("key")
+        keys.append(key)
+        for v in ax.get("values", []) or []:
+            if v is None and key != "sensor.footprint_radius":
+                problems.append(
+                    f"decisions.map.{axis}.values: null is only allowed for "
+                    f"sensor.footprint_radius (unlimited), not for {key}"
+                )
+            elif v is not None and not (isinstance(v, int | float) and 0 < v <= 100000):
+                problems.append(
+                    f"decisions.map.{axis}.values: {v!r} is invalid for {key} "
+                    "(allowed: number in (0, 100000])"
+                )
+    if keys[0] is not None and keys[0] == keys[1]:
+        problems.append(
+            f"decisions.map.cols.key: {keys[1]} is also the rows' key (allowed: two different keys)"
+        )
     return problems
 
 

@@ -1,8 +1,24 @@
 # Decision-quality study: the regret of the controls each method chooses.
-# Simulation, aggregation and figures are separate rules.
+# Simulation, aggregation and figures are separate rules; the sensitivity map runs one job
+# per cell (wildcard {cell} = r<i>c<j>), so a cell reruns alone and cells fan out.
+from rsmhp.experiments.decisions_uav import map_cells
 
+DEC = config["decisions"]
+MAP_CELLS = [c.name for c in map_cells(DEC["map"])]
+# the scoring settings of the open-loop regret, shared by the map cells
+DEC_SCORING = pick(
+    DEC["uav"], "n_eval", "polish", "random_starts", "eval_maxiter", "n_random"
+)
+DEC_FIGURES = ["dec_lqg_regret", "dec_uav_regret", "dec_uav_map"]
+DEC_REC = DEC["recording"]
+DEC_RECORDING = f"results/recordings/dec_{DEC_REC['model']}_run{DEC_REC['run']}.rrd"
 REPORT_SECTIONS["decisions_lqg"] = "results/report/decisions_lqg.json"
-REPORT_FIGURES.append("dec_lqg_regret")
+REPORT_SECTIONS["decisions_uav"] = "results/report/decisions_uav.json"
+REPORT_FIGURES.extend(DEC_FIGURES)
+
+
+wildcard_constraints:
+    cell=r"r\d+c\d+",
 
 
 rule decisions_lqg:
@@ -53,11 +69,95 @@ rule decisions_lqg_summary:
         "../scripts/decisions_lqg_summary.py"
 
 
+rule decisions_uav:
+    output:
+        "results/decisions/uav_regret.csv",
+    log:
+        "results/logs/decisions_uav.log",
+    benchmark:
+        "results/benchmarks/decisions_uav.tsv"
+    conda:
+        ENV
+    threads: THREADS
+    resources:
+        mem_mb=2000,
+        runtime=60,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        cfg=canonical(DEC["uav"]),
+        seed=config["seed"],
+    script:
+        "../scripts/decisions_uav.py"
+
+
+rule decisions_map_cell:
+    output:
+        runs="results/decisions/map/{cell}.csv",
+        regret="results/decisions/map/{cell}_regret.csv",
+    log:
+        "results/logs/decisions_map_cell/{cell}.log",
+    benchmark:
+        "results/benchmarks/decisions_map_cell/{cell}.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=60,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        cfg=pick(
+            DEC["map"],
+            "rows",
+            "cols",
+            "runs",
+            "methods",
+            "regret_runs",
+            "regret_steps",
+            "track_loss_error",
+        ),
+        scoring=DEC_SCORING,
+        seed=config["seed"],
+    script:
+        "../scripts/decisions_map_cell.py"
+
+
+rule decisions_uav_summary:
+    input:
+        regret="results/decisions/uav_regret.csv",
+        map_runs=expand("results/decisions/map/{cell}.csv", cell=MAP_CELLS),
+        map_regret=expand("results/decisions/map/{cell}_regret.csv", cell=MAP_CELLS),
+    output:
+        regret_summary="results/decisions/uav_regret_summary.csv",
+        map="results/decisions/uav_map.csv",
+        tables=expand(
+            "results/tables/{name}.md", name=["dec_uav_regret", "dec_uav_map"]
+        ),
+        section="results/report/decisions_uav.json",
+    log:
+        "results/logs/decisions_uav_summary.log",
+    benchmark:
+        "results/benchmarks/decisions_uav_summary.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        cfg=canonical(DEC),
+        seed=config["seed"],
+    script:
+        "../scripts/decisions_uav_summary.py"
+
+
 rule decisions_figures:
     input:
         lqg="results/decisions/lqg_summary.csv",
+        regret="results/decisions/uav_regret.csv",
+        map="results/decisions/uav_map.csv",
     output:
-        expand("results/figures/dec_lqg_regret.{ext}", ext=("png", "pdf")),
+        expand("results/figures/{name}.{ext}", name=DEC_FIGURES, ext=("png", "pdf")),
     log:
         "results/logs/decisions_figures.log",
     benchmark:
@@ -72,8 +172,33 @@ rule decisions_figures:
         "../scripts/decisions_figures.py"
 
 
+rule decisions_recording:
+    output:
+        DEC_RECORDING,
+    log:
+        "results/logs/decisions_recording.log",
+    benchmark:
+        "results/benchmarks/decisions_recording.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(DEC["uav"]["models"]),
+        methods=canonical(DEC["uav"]["methods"]),
+        recording=canonical(DEC_REC),
+        seed=config["seed"],
+    script:
+        "../scripts/decisions_recording.py"
+
+
 rule decisions:
     input:
         rules.decisions_lqg.output,
         rules.decisions_lqg_summary.output,
+        rules.decisions_uav_summary.output,
         rules.decisions_figures.output,
+        rules.decisions_recording.output,

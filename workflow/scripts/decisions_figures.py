@@ -2,13 +2,19 @@
 
 from pathlib import Path
 
-from rsmhp.analysis.decisions import LQG_SUMMARY_COLUMNS
+from rsmhp.analysis.decisions import LQG_SUMMARY_COLUMNS, MAP_COLUMNS
+from rsmhp.experiments.decisions_uav import REGRET_COLUMNS
 from rsmhp.figures import decisions as figs
-from rsmhp.figures import save_figure
+from rsmhp.figures import save_figure, seeded_legacy_random
 from rsmhp.io import read_table
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake.log[0], snakemake.rule):
-    summary = read_table(snakemake.input.lqg, LQG_SUMMARY_COLUMNS)
     outdir = Path(snakemake.output[0]).parent
+    summary = read_table(snakemake.input.lqg, LQG_SUMMARY_COLUMNS)
     save_figure(figs.lqg_regret_figure(summary), outdir / "dec_lqg_regret")
+    regret = read_table(snakemake.input.regret, REGRET_COLUMNS)
+    with seeded_legacy_random("dec_uav_regret"):  # strip-plot jitter
+        save_figure(figs.uav_regret_figure(regret), outdir / "dec_uav_regret")
+    map_df = read_table(snakemake.input.map, MAP_COLUMNS)
+    save_figure(figs.uav_map_figure(map_df), outdir / "dec_uav_map")

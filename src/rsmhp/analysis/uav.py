@@ -295,6 +295,27 @@ def uav_tables(summary: pd.DataFrame, paired: pd.DataFrame) -> dict[str, str]:
     }
 
 
+def _variant_note(sensor: dict) -> str:
+    """A sentence naming the model variant when the sensor is not the reconstruction's."""
+    parts = []
+    if sensor.get("footprint_radius") is not None:
+        parts.append(
+            f"a sensor footprint of radius {sensor['footprint_radius']:g} m (truth detections "
+            f"{sensor.get('detection', 'hard')}, planner width "
+            f"{sensor.get('footprint_width', 10):g} m)"
+        )
+    if sensor.get("noise_growth", "linear") != "linear":
+        parts.append(
+            f"noise growing quadratically with distance (reference "
+            f"{sensor.get('reference_distance', 100):g} m)"
+        )
+    if not parts:
+        return ""
+    return (
+        " **Model variant, not the paper's model:** " + "; ".join(parts) + " (`rsmhp.uav.sensor`)."
+    )
+
+
 def uav_section(
     summary: pd.DataFrame,
     paired: pd.DataFrame,
@@ -324,7 +345,8 @@ def uav_section(
             "Σ_{k=1..H} tr P_k averaged over the hypotheses, L-BFGS-B on the control box with "
             f"at most {pl['maxiter']} iterations / {pl['maxfun']} evaluations, exact gradient "
             "(adjoint of the covariance recursion and the kinematics, compiled kernel), warm "
-            "start from the shifted previous plan; identical for every method.",
+            "start from the shifted previous plan; identical for every method."
+            + _variant_note(setting["sensor"]),
             "",
             f"Study: {n_runs} runs × {sc['steps']} steps per method. Each run draws its scenario "
             f"(target speed {sc['target_speed_min']:g}-{sc['target_speed_max']:g} m/s, UAV "

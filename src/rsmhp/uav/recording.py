@@ -13,6 +13,8 @@ For each method ``<m>`` (entity per method, its own 2-D view):
 * ``<m>/map/estimate``, ``<m>/map/ellipse``  the tracker's estimate and its 2-sigma position
   ellipse (closed polygon of :math:`\\hat p + 2 L (\\cos t, \\sin t)`, :math:`L L^T` the
   position block of :math:`\\hat P`; ``Ellipses2D`` has no rotation)
+* ``<m>/map/footprint``    LineStrips2D (model variants with a sensor footprint only): the
+  footprint circle around the UAV, green when the step measured, red when it did not
 * ``error/<m>``, ``trace/<m>``  Scalars: :math:`\\|\\hat p_k - p_k\\|` and
   :math:`\\mathrm{tr}\\,\\hat P_k` (one time-series view each, methods overlaid)
 
@@ -39,6 +41,8 @@ PLAN_C = (120, 170, 255)
 TRUE_C = (20, 20, 20)
 EST_C = (220, 60, 40)
 HYP_C = (160, 160, 160, 90)
+SEEN_C = (40, 170, 70)
+MISSED_C = (210, 40, 40)
 
 
 def ellipse_polygon(mean: np.ndarray, cov: np.ndarray, n_sigma: float = 2.0, n: int = 48):
@@ -51,8 +55,17 @@ def ellipse_polygon(mean: np.ndarray, cov: np.ndarray, n_sigma: float = 2.0, n: 
 class _MethodLogger:
     """Observer of :func:`rsmhp.uav.simulation.simulate_run` that logs one method's entities."""
 
-    def __init__(self, rec, log, name: str, uav_start: np.ndarray, max_hypotheses: int) -> None:
+    def __init__(
+        self,
+        rec,
+        log,
+        name: str,
+        uav_start: np.ndarray,
+        max_hypotheses: int,
+        footprint: float | None = None,
+    ) -> None:
         self.rec, self.log, self.name, self.max_hyp = rec, log, name, max_hypotheses
+        self.footprint = footprint
         self.base = f"{name}/map"
         self.uav_path = [np.asarray(uav_start, dtype=float).copy()]
         self.tgt_path: list[np.ndarray] = []
@@ -73,6 +86,11 @@ class _MethodLogger:
         log(f"{base}/estimate", rr.Points2D([info.estimate[:2]], colors=[EST_C], radii=4.0))
         ell = ellipse_polygon(info.estimate[:2], info.covariance[:2, :2])
         log(f"{base}/ellipse", rr.LineStrips2D([ell], colors=[EST_C], radii=0.8))
+        if self.footprint is not None:
+            t = np.linspace(0.0, 2 * np.pi, 73)
+            ring = info.uav[:2] + self.footprint * np.column_stack([np.cos(t), np.sin(t)])
+            color = SEEN_C if info.detected else MISSED_C
+            log(f"{base}/footprint", rr.LineStrips2D([ring], colors=[color], radii=1.0))
         log(f"error/{self.name}", rr.Scalars(info.error))
         log(f"trace/{self.name}", rr.Scalars(info.trace))
 
@@ -107,7 +125,8 @@ def record_uav_run(
     equal those of the Monte-Carlo study for the same run).
     """
     names = [m.name for m in methods]
-    job = canonical_job_id("uav_recording", seed=seed, run=run, methods=names)
+    variant = {} if not setup.sensor.limited else {"footprint": setup.sensor.footprint_radius}
+    job = canonical_job_id("uav_recording", seed=seed, run=run, methods=names, **variant)
     rec = rr.RecordingStream("rsmhp_uav", recording_id=str(uuid.uuid5(uuid.NAMESPACE_URL, job)))
     rec.set_log_time_enabled(False)
     Path(path).parent.mkdir(parents=True, exist_ok=True)
@@ -123,7 +142,8 @@ def record_uav_run(
         log(f"error/{m.name}", rr.SeriesLines(names=m.name, widths=1.5), static=True)
         log(f"trace/{m.name}", rr.SeriesLines(names=m.name, widths=1.5), static=True)
         start = draw_scenario(setup, seed, run).uav[:2]
-        observer = _MethodLogger(rec, log, m.name, start, max_hypotheses)
+        footprint = setup.sensor.footprint_radius if setup.sensor.limited else None
+        observer = _MethodLogger(rec, log, m.name, start, max_hypotheses, footprint)
         summary, _ = simulate_run(setup, m, seed, run, observer=observer)
         summaries.append(summary)
     rec.disconnect()

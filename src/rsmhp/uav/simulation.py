@@ -167,6 +167,8 @@ class StepInfo:
     hypotheses: np.ndarray
     error: float
     trace: float
+    warm_start: np.ndarray | None = None  # (H, 2) the next step's warm start (shifted plan)
+    detected: bool = True  # whether the step measured (False only outside a footprint)
 
 
 def _hypotheses(
@@ -263,7 +265,7 @@ def _simulate_run(setup, method, seed, run, observer):
         if limited:  # variant-only column: the paper's model's outputs stay as they were
             rows[-1]["detected"] = bool(seen)
         if observer is not None:
-            observer(StepInfo(k, uav_state, x_true, x_est, P_est, res.uav_path, hyp, err, tr))
+            observer(StepInfo(k, uav_state, x_true, x_est, P_est, res.uav_path, hyp, err, tr, warm))
     errors = np.array([r["error"] for r in rows])
     summary = {
         "method": method.name,

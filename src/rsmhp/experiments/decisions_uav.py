@@ -1,0 +1,433 @@
+r"""UAV decision study: open-loop regret of each method's plan at belief states, and paired
+closed-loop runs of the methods on model variants (the sensitivity map).
+
+Belief states
+-------------
+Closed-loop NBO runs of a model (runs ``0..n-1``, the main study's scenarios and noise,
+:mod:`rsmhp.uav.simulation`) are stopped at the configured steps; the belief state "at step
+k" is what the planner sees before planning step k+1: UAV state, tracker mean
+:math:`\hat x_k` and covariance :math:`\hat P_k`, and the warm start (NBO's shifted plan;
+zeros at k = 0, where :math:`\hat P_0 = P_0`, the most uncertain state).
+
+Open-loop regret at one belief state
+------------------------------------
+Every method plans once, exactly as in the closed loop (its own hypotheses from
+``job_rng(seed, "decisions_uav_plan", model=, run=, step=, method=, N_T=, N=, M=)``, same
+warm start, same optimiser budget). Every plan is then scored on an independent evaluation
+set of ``n_eval`` hypotheses drawn from the belief (``job_rng(seed, "decisions_uav_eval",
+model=, run=, step=)``): :math:`\hat J_{ev}(x) = \frac1{T}\sum_i c_i(x)`, with
+:math:`c_i(x) = \sum_j \mathrm{tr} P^i_j(x)` the planner's cost for hypothesis i. The
+reference plan is the best of every method's plan and of a multi-start L-BFGS-B on
+:math:`\hat J_{ev}` itself (starts: the ``polish`` best plans so far and ``random_starts``
+uniform points of the box, ``eval_maxiter`` iterations). Regret of a plan :math:`x`:
+:math:`\hat J_{ev}(x) - \hat J_{ev}(x_{best}) \ge 0`, with Monte-Carlo standard error
+:math:`\mathrm{sd}_i(c_i(x) - c_i(x_{best}))/\sqrt T` (paired over the same hypotheses).
+Because :math:`x_{best}` is optimised on the evaluation set, the regret is biased upwards by
+at most that optimisation's overfit, :math:`O(1/T)`.
+
+``regret_methods`` is the same difference against the best of the methods' plans only: the
+part of the regret due to the cost approximation, at the methods' common optimiser budget
+(the rest is the optimiser stopping at a poorer local minimum than the multi-start).
+
+Rank agreement: ``n_random`` plans uniform in the box (and ``n_random`` local perturbations
+of the best plan, :math:`x_{best} + \mathcal N(0, 0.1^2)` clipped to the box) are costed by
+every method's own objective and by :math:`\hat J_{ev}`; Spearman's rank correlation
+between the two.
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import logging
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from scipy import stats
+from scipy.optimize import minimize
+from threadpoolctl import threadpool_limits
+
+from rsmhp.parallel import parallel_map
+from rsmhp.seeding import job_rng
+from rsmhp.uav import fused, target
+from rsmhp.uav.planner import PlanningProblem, _box, plan
+from rsmhp.uav.simulation import (
+    MethodSpec,
+    StepInfo,
+    UAVSetup,
+    _hypotheses,
+    draw_scenario,
+    method_specs,
+    simulate_run,
+)
+
+__all__ = [
+    "MAP_RUN_COLUMNS",
+    "REGRET_COLUMNS",
+    "BeliefState",
+    "MapCell",
+    "belief_states",
+    "map_cells",
+    "merge_variant",
+    "recording_setup",
+    "run_map_cell",
+    "run_uav_regret",
+    "score_state",
+]
+
+log = logging.getLogger(__name__)
+
+REGRET_COLUMNS = [
+    "model",
+    "run",
+    "step",
+    "trace_P",
+    "method",
+    "family",
+    "N_T",
+    "N",
+    "M",
+    "plan_cost",
+    "eval_cost",
+    "eval_se",
+    "best_cost",
+    "regret",
+    "regret_se",
+    "regret_rel",
+    "regret_methods",
+    "spearman_random",
+    "spearman_local",
+    "n_eval",
+]
+MAP_RUN_COLUMNS = [
+    "cell",
+    "row_value",
+    "col_value",
+    "method",
+    "run",
+    "mean_error",
+    "final_error",
+    "detect_rate",
+    "lost",
+]
+
+
+def merge_variant(uav: Mapping[str, Any], variant: Mapping[str, Any]) -> dict[str, Any]:
+    """The ``uav`` config section with a model variant's overrides (``sensor``, ``target``,
+    ``tracker`` sub-keys) merged in; ``name`` is ignored."""
+    out = copy.deepcopy(dict(uav))
+    for section, values in variant.items():
+        if section == "name":
+            continue
+        if section not in ("sensor", "target", "tracker"):
+            raise ValueError(
+                f"model variant: unknown section {section!r} (allowed: sensor, target, tracker)"
+            )
+        out[section] = {**out.get(section, {}), **dict(values)}
+    return out
+
+
+@dataclass(frozen=True)
+class BeliefState:
+    """The planner's input at one step of one closed-loop run."""
+
+    model: str
+    run: int
+    step: int
+    uav: np.ndarray
+    x_hat: np.ndarray
+    P_hat: np.ndarray
+    warm: np.ndarray
+
+
+def belief_states(
+    setup: UAVSetup, model: str, seed: int, runs: Sequence[int], steps: Sequence[int]
+) -> list[BeliefState]:
+    """Belief states of closed-loop NBO runs ``runs`` at ``steps`` (0 = the initial belief)."""
+    H = setup.planner.horizon
+    wanted = sorted(set(int(s) for s in steps))
+    if wanted and wanted[-1] >= setup.steps:
+        raise ValueError(
+            f"belief-state step {wanted[-1]} is not before the run's last step {setup.steps}"
+        )
+    nbo = MethodSpec("nbo", "nbo", 1)
+    out: list[BeliefState] = []
+    for run in runs:
+        got: dict[int, BeliefState] = {}
+        if 0 in wanted:
+            sc = draw_scenario(setup, seed, run)
+            got[0] = BeliefState(model, run, 0, sc.uav, sc.estimate, setup.P0, np.zeros((H, 2)))
+        later = [k for k in wanted if k > 0]
+        if later:
+
+            def observe(info: StepInfo, run=run, got=got, later=later) -> None:
+                if info.step in later:
+                    got[info.step] = BeliefState(
+                        model,
+                        run,
+                        info.step,
+                        info.uav.copy(),
+                        info.estimate.copy(),
+                        info.covariance.copy(),
+                        info.warm_start.copy(),
+                    )
+
+            short = dataclasses.replace(setup, steps=max(later))
+            simulate_run(short, nbo, seed, run, observer=observe)
+        out.extend(got[k] for k in wanted)
+    return out
+
+
+def _positions(x: np.ndarray, problem: PlanningProblem) -> np.ndarray:
+    return np.stack([fused.path(xi, problem._frozen)[:, :2] for xi in np.atleast_2d(x)])
+
+
+def score_state(
+    state: BeliefState,
+    setup: UAVSetup,
+    methods: Mapping[str, MethodSpec],
+    cfg: Mapping[str, Any],
+    seed: int,
+) -> list[dict[str, Any]]:
+    """One row per method (see the module docstring)."""
+    H = setup.planner.horizon
+    ident = {"model": state.model, "run": state.run, "step": state.step}
+    eval_rng = job_rng(seed, "decisions_uav_eval", **ident)
+    n_eval = int(cfg["n_eval"])
+    eval_xy = target.sample_independent(
+        state.x_hat, state.P_hat, H, n_eval, setup.target, eval_rng
+    )[..., :2]
+    args = (setup.uav, setup.target, setup.sensor, setup.planner)
+    ev = PlanningProblem(state.uav, state.P_hat, eval_xy, *args)
+    plans: dict[str, tuple[np.ndarray, float, PlanningProblem]] = {}
+    for name, spec in methods.items():
+        rng = job_rng(seed, "decisions_uav_plan", **ident, **spec.job_params())
+        hyp = _hypotheses(spec, state.x_hat, state.P_hat, setup, rng)
+        prob = PlanningProblem(state.uav, state.P_hat, hyp[..., :2], *args)
+        res = plan(prob, state.warm)
+        plans[name] = (res.controls.ravel() / prob.scale, res.cost, prob)
+    # reference: multi-start L-BFGS-B on the evaluation cost
+    aux = job_rng(seed, "decisions_uav_aux", **ident)
+    cands = np.array([p[0] for p in plans.values()])
+    cand_cost = ev.costs(cands)
+    starts = [cands[i] for i in np.argsort(cand_cost, kind="stable")[: int(cfg["polish"])]]
+    starts += list(aux.uniform(-1.0, 1.0, (int(cfg["random_starts"]), 2 * H)))
+    best_x, best_f = cands[int(np.argmin(cand_cost))], float(cand_cost.min())
+    for x0 in starts:
+        res = minimize(
+            ev.value_and_grad,
+            x0,
+            jac=True,
+            method="L-BFGS-B",
+            bounds=_box(x0.size),
+            options={"maxiter": int(cfg["eval_maxiter"])},
+        )
+        if res.fun < best_f:
+            best_x, best_f = np.clip(res.x, -1.0, 1.0), float(res.fun)
+    # per-hypothesis costs c_i of every plan and of the best, on the evaluation set
+    all_x = np.vstack([cands, best_x[None, :]])
+    per_hyp = fused.covariance_traces(
+        state.P_hat, _positions(all_x, ev), eval_xy, setup.target.dt, setup.target.Q, setup.sensor
+    ).sum(axis=2)  # (C+1, T)
+    best_c = per_hyp[-1]
+    best_cost = float(best_c.mean())
+    best_method_cost = float(per_hyp[:-1].mean(axis=1).min())
+    # rank agreement on random and on local plans
+    n_rand = int(cfg["n_random"])
+    rand = aux.uniform(-1.0, 1.0, (n_rand, 2 * H))
+    local = np.clip(best_x + aux.normal(0.0, 0.1, (n_rand, 2 * H)), -1.0, 1.0)
+    ev_rand, ev_local = ev.costs(rand), ev.costs(local)
+    rows = []
+    for k, (name, (_, own, prob)) in enumerate(plans.items()):
+        spec = methods[name]
+        diff = per_hyp[k] - best_c
+        rows.append(
+            {
+                **ident,
+                "trace_P": float(np.trace(state.P_hat)),
+                "method": name,
+                "family": spec.family,
+                "N_T": spec.n_traj,
+                "N": spec.n_branch or 0,
+                "M": spec.max_keep or 0,
+                "plan_cost": own,
+                "eval_cost": float(per_hyp[k].mean()),
+                "eval_se": float(per_hyp[k].std(ddof=1) / np.sqrt(n_eval)),
+                "best_cost": best_cost,
+                "regret": float(diff.mean()),
+                "regret_se": float(diff.std(ddof=1) / np.sqrt(n_eval)),
+                "regret_rel": float(diff.mean() / best_cost),
+                "regret_methods": float(per_hyp[k].mean() - best_method_cost),
+                "spearman_random": _spearman(prob.costs(rand), ev_rand),
+                "spearman_local": _spearman(prob.costs(local), ev_local),
+                "n_eval": n_eval,
+            }
+        )
+    return rows
+
+
+def _spearman(a: np.ndarray, b: np.ndarray) -> float:
+    """Spearman's rho; NaN when either side is constant (e.g. NBO's cost when its single
+    hypothesis is out of every plan's footprint: the cost cannot rank the plans)."""
+    if np.ptp(a) == 0.0 or np.ptp(b) == 0.0:
+        return float("nan")
+    return float(stats.spearmanr(a, b).statistic)
+
+
+def _score_task(job) -> list[dict[str, Any]]:
+    states, uav_cfg, methods_cfg, cfg, seed = job
+    setup = UAVSetup.from_config(uav_cfg)
+    methods = method_specs({"methods": methods_cfg})
+    with threadpool_limits(limits=1):
+        return [row for st in states for row in score_state(st, setup, methods, cfg, seed)]
+
+
+def run_uav_regret(
+    uav: Mapping[str, Any], cfg: Mapping[str, Any], seed: int, n_jobs: int = 1
+) -> pd.DataFrame:
+    """The open-loop study of the ``decisions.uav`` section for every model variant in
+    ``cfg["models"]``; ``uav`` is the (validated) ``uav`` config section."""
+    jobs = []
+    n_states = 0
+    for variant in cfg["models"]:
+        uav_cfg = merge_variant(uav, variant)
+        setup = UAVSetup.from_config(uav_cfg)
+        with threadpool_limits(limits=1):
+            states = belief_states(
+                setup, variant["name"], seed, range(int(cfg["runs"])), cfg["steps"]
+            )
+        n_states += len(states)
+        # one task per run's states (a task's rows never depend on the task split)
+        by_run: dict[int, list[BeliefState]] = {}
+        for st in states:
+            by_run.setdefault(st.run, []).append(st)
+        jobs += [(sts, uav_cfg, cfg["methods"], cfg, seed) for sts in by_run.values()]
+    log.info(
+        "decisions_uav: %d belief states x %d methods in %d tasks on %d workers",
+        n_states,
+        len(method_specs({"methods": cfg["methods"]})),
+        len(jobs),
+        n_jobs,
+    )
+    rows = [r for part in parallel_map(_score_task, jobs, n_jobs, desc="states") for r in part]
+    return pd.DataFrame(rows, columns=REGRET_COLUMNS)
+
+
+# ------------------------------------------------------------------------ sensitivity map
+
+
+@dataclass(frozen=True)
+class MapCell:
+    """One cell of the map: its name (``r<i>c<j>``, the rule wildcard) and model variant."""
+
+    name: str
+    row: int
+    col: int
+    row_value: Any
+    col_value: Any
+    variant: dict
+
+
+def _set(variant: dict, key: str, value: Any) -> None:
+    section, field = key.split(".")
+    variant.setdefault(section, {})[field] = value
+
+
+def map_cells(cfg: Mapping[str, Any]) -> list[MapCell]:
+    """The cells of the ``decisions.map`` section: rows x cols, each axis a dotted key
+    (``sensor.footprint_radius``, ``target.q``, ...) and its values (``null`` for a
+    footprint radius means unlimited)."""
+    cells = []
+    rows, cols = cfg["rows"], cfg["cols"]
+    for i, rv in enumerate(rows["values"]):
+        for j, cv in enumerate(cols["values"]):
+            variant: dict = {}
+            _set(variant, rows["key"], rv)
+            _set(variant, cols["key"], cv)
+            cells.append(MapCell(f"r{i}c{j}", i, j, rv, cv, variant))
+    return cells
+
+
+def run_map_cell(
+    uav: Mapping[str, Any],
+    cfg: Mapping[str, Any],
+    scoring: Mapping[str, Any],
+    cell_name: str,
+    seed: int,
+    n_jobs: int = 1,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """Paired closed-loop runs of every map method in one cell (runs ``0..runs-1``, the same
+    scenarios and noise for every method and every cell), and the open-loop regret at the
+    belief states of NBO runs ``0..regret_runs-1`` at ``regret_steps``, scored as in
+    :func:`score_state` with the settings ``scoring`` (n_eval, polish, random_starts,
+    eval_maxiter, n_random).
+
+    A run *loses the track* when its final location error exceeds ``track_loss_error`` m.
+    Returns (one row per (method, run): :data:`MAP_RUN_COLUMNS`; open-loop regret rows:
+    :data:`REGRET_COLUMNS` with ``model`` = the cell name)."""
+    cells = {c.name: c for c in map_cells(cfg)}
+    if cell_name not in cells:
+        raise ValueError(f"unknown map cell {cell_name!r}; cells: {', '.join(cells)}")
+    cell = cells[cell_name]
+    uav_cfg = merge_variant(uav, cell.variant)
+    methods = method_specs({"methods": cfg["methods"]})
+    runs = list(range(int(cfg["runs"])))
+    jobs = [(uav_cfg, methods[m], seed, r) for m in methods for r in runs]
+    log.info("map cell %s (%s): %d closed-loop runs", cell.name, cell.variant, len(jobs))
+    summaries = parallel_map(_closed_loop_task, jobs, n_jobs, desc=f"cell {cell.name} runs")
+    loss = float(cfg["track_loss_error"])
+    run_rows = [
+        {
+            "cell": cell.name,
+            "row_value": cell.row_value,
+            "col_value": cell.col_value,
+            "method": s["method"],
+            "run": s["run"],
+            "mean_error": s["mean_error"],
+            "final_error": s["final_error"],
+            "detect_rate": s.get("detect_rate", 1.0),
+            "lost": bool(s["final_error"] > loss),
+        }
+        for s in summaries
+    ]
+    setup = UAVSetup.from_config(uav_cfg)
+    with threadpool_limits(limits=1):
+        states = belief_states(
+            setup, cell.name, seed, range(int(cfg["regret_runs"])), cfg["regret_steps"]
+        )
+    jobs2 = [([st], uav_cfg, cfg["methods"], dict(scoring), seed) for st in states]
+    regret = [r for part in parallel_map(_score_task, jobs2, n_jobs, desc="states") for r in part]
+    return (
+        pd.DataFrame(run_rows, columns=MAP_RUN_COLUMNS),
+        pd.DataFrame(regret, columns=REGRET_COLUMNS),
+    )
+
+
+def _closed_loop_task(job) -> dict[str, Any]:
+    uav_cfg, spec, seed, run = job
+    summary, _ = simulate_run(UAVSetup.from_config(uav_cfg), spec, seed, run)
+    return summary
+
+
+def recording_setup(
+    uav: Mapping[str, Any],
+    models: Sequence[Mapping[str, Any]],
+    methods: Mapping[str, Any],
+    model: str,
+) -> tuple[UAVSetup, list[MethodSpec]]:
+    """The setup of model variant ``model`` of ``models`` and the methods a decision
+    recording shows: NBO and RS-MHP with the largest N_T of ``methods``."""
+    variants = {m["name"]: m for m in models}
+    if model not in variants:
+        raise ValueError(
+            f"decisions.recording.model: {model!r} is not one of {', '.join(variants)}"
+        )
+    setup = UAVSetup.from_config(merge_variant(uav, variants[model]))
+    specs = [MethodSpec("nbo", "nbo", 1)]
+    if methods.get("rsmhp_nt"):
+        n = max(int(v) for v in methods["rsmhp_nt"])
+        specs.append(MethodSpec(f"rsmhp_nt{n}", "rsmhp", n))
+    return setup, specs

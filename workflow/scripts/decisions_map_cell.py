@@ -1,0 +1,17 @@
+"""Rule decisions_map_cell: paired closed-loop runs and open-loop regret of one map cell."""
+
+from rsmhp.experiments.decisions_uav import run_map_cell
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake.log[0], snakemake.rule):
+    runs, regret = run_map_cell(
+        snakemake.params.uav,
+        snakemake.params.cfg,
+        snakemake.params.scoring,
+        snakemake.wildcards.cell,
+        snakemake.params.seed,
+        snakemake.threads,
+    )
+    write_csv(runs, snakemake.output.runs)
+    write_csv(regret, snakemake.output.regret)
