@@ -95,3 +95,73 @@ def test_all_problems_reported_at_once():
 def test_bad_uav_values_are_named(path, value, expected):
     with pytest.raises(ConfigError, match=expected):
         check_config(_with(path, value))
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "expected"),
+    [
+        # model variants of the sensor
+        ("uav.sensor.footprint_radius", 0.0, r"uav\.sensor\.footprint_radius: 0\.0 is invalid"),
+        ("uav.sensor.footprint_radius", "far", r"uav\.sensor\.footprint_radius: 'far'"),
+        ("uav.sensor.footprint_width", -2.0, r"uav\.sensor\.footprint_width: -2\.0"),
+        ("uav.sensor.detection", "soft", r"uav\.sensor\.detection: 'soft'.*hard"),
+        ("uav.sensor.noise_growth", "cubic", r"uav\.sensor\.noise_growth: 'cubic'.*quadratic"),
+        ("uav.sensor.reference_distance", 0, r"uav\.sensor\.reference_distance: 0 "),
+        # decisions.lqg
+        ("decisions.lqg.a_values", [1.0], r"decisions\.lqg\.a_values\[0\]: 1\.0 .*\(0, 1\)"),
+        ("decisions.lqg.H_values", [0], r"decisions\.lqg\.H_values\[0\]: 0 "),
+        ("decisions.lqg.P", [15], r"decisions\.lqg\.P\[0\]: 15 .*multiple of 2"),
+        ("decisions.lqg.tree_N", [1], r"decisions\.lqg\.tree_N\[0\]: 1 "),
+        ("decisions.lqg.pruned_N", 1, r"decisions\.lqg\.pruned_N: 1 "),
+        ("decisions.lqg.max_leaves", 0, r"decisions\.lqg\.max_leaves: 0 "),
+        ("decisions.lqg.replicates", 1, r"decisions\.lqg\.replicates: 1 "),
+        ("decisions.lqg.methods", ["greedy"], r"decisions\.lqg\.methods\[0\]: 'greedy'"),
+        # decisions.uav
+        ("decisions.uav.models", [{"name": "Bad Name"}], r"decisions\.uav\.models\[0\]\.name"),
+        (
+            "decisions.uav.models",
+            [{"name": "x", "sensor": {"footprint_radius": -5}}],
+            r"decisions\.uav\.models\[0\]\.sensor\.footprint_radius: -5",
+        ),
+        (
+            "decisions.uav.models",
+            [{"name": "x", "planner": {"horizon": 3}}],
+            r"decisions\.uav\.models\[0\]\.planner: unknown key",
+        ),
+        ("decisions.uav.models", [{"name": "a"}, {"name": "a"}], r"duplicate name"),
+        ("decisions.uav.runs", 0, r"decisions\.uav\.runs: 0 "),
+        ("decisions.uav.steps", [0, 60], r"decisions\.uav\.steps: \[60\] not before"),
+        ("decisions.uav.n_eval", 5, r"decisions\.uav\.n_eval: 5 "),
+        ("decisions.uav.polish", -1, r"decisions\.uav\.polish: -1 "),
+        ("decisions.uav.random_starts", -1, r"decisions\.uav\.random_starts: -1 "),
+        ("decisions.uav.eval_maxiter", 0, r"decisions\.uav\.eval_maxiter: 0 "),
+        ("decisions.uav.n_random", 2, r"decisions\.uav\.n_random: 2 "),
+        ("decisions.uav.methods", {"nbo": False, "rsmhp_nt": [], "tree": []}, r"no method"),
+        # decisions.map
+        (
+            "decisions.map.rows",
+            {"key": "planner.horizon", "values": [1]},
+            r"decisions\.map\.rows\.key",
+        ),
+        (
+            "decisions.map.cols",
+            {"key": "target.q", "values": [None]},
+            r"decisions\.map\.cols\.values: null is only allowed",
+        ),
+        (
+            "decisions.map.cols",
+            {"key": "sensor.footprint_radius", "values": [100.0]},
+            r"also the rows' key",
+        ),
+        ("decisions.map.runs", 1, r"decisions\.map\.runs: 1 "),
+        ("decisions.map.methods", {"nbo": True, "rsmhp_nt": [], "tree": []}, r"fewer than 2"),
+        ("decisions.map.regret_steps", [70], r"decisions\.map\.regret_steps: \[70\]"),
+        ("decisions.map.track_loss_error", 0, r"decisions\.map\.track_loss_error: 0 "),
+        ("decisions.map.bootstrap", 10, r"decisions\.map\.bootstrap: 10 "),
+        ("decisions.recording.model", "nothere", r"decisions\.recording\.model: 'nothere'"),
+        ("decisions.recording.run", -1, r"decisions\.recording\.run: -1 "),
+    ],
+)
+def test_bad_decision_values_are_named(path, value, expected):
+    with pytest.raises(ConfigError, match=expected):
+        check_config(_with(path, value))

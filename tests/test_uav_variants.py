@@ -223,3 +223,28 @@ def test_sensor_model_refuses_bad_values():
         dataclasses.replace(BASE, footprint_width=0.0)
     with pytest.raises(ValueError, match="detection"):
         dataclasses.replace(BASE, detection="soft")
+
+
+def test_recording_draws_the_footprint(tmp_path):
+    from rerun.chunk import RrdReader
+
+    from rsmhp.uav.recording import record_uav_run
+
+    cfg = _short_cfg(footprint_radius=150.0)
+    setup = UAVSetup.from_config(cfg)
+    specs = list(method_specs(cfg).values())
+    rows, summaries = record_uav_run(tmp_path / "fp.rrd", setup, specs, 3, 0, max_hypotheses=3)
+    for spec in specs:
+        assert rows[f"{spec.name}/map/footprint"] == setup.steps
+    counts: dict[str, int] = {}
+    for chunk in RrdReader(tmp_path / "fp.rrd").store().stream():
+        counts[chunk.entity_path] = counts.get(chunk.entity_path, 0) + chunk.num_rows
+    assert counts["/nbo/map/footprint"] == setup.steps
+    # the recorded runs are the study's runs
+    s, _ = simulate_run(setup, specs[0], 3, 0)
+    assert summaries[0]["mean_error"] == s["mean_error"]
+    # no footprint, no footprint entity
+    rows, _ = record_uav_run(
+        tmp_path / "plain.rrd", UAVSetup.from_config(_short_cfg()), specs, 3, 0
+    )
+    assert not any(k.endswith("/footprint") for k in rows)
