@@ -155,6 +155,16 @@ def test_bad_uav_values_are_named(path, value, expected):
         ),
         ("decisions.map.runs", 1, r"decisions\.map\.runs: 1 "),
         ("decisions.map.methods", {"nbo": True, "rsmhp_nt": [], "tree": []}, r"fewer than 2"),
+        (
+            "decisions.map.methods",
+            {"nbo": False, "rsmhp_nt": [100, 250], "tree": []},
+            r"decisions\.map\.methods\.nbo: false",
+        ),
+        (
+            "decisions.uav.methods",
+            {"nbo": False, "rsmhp_nt": [100], "tree": []},
+            r"decisions\.uav\.methods\.nbo: false",
+        ),
         ("decisions.map.regret_steps", [70], r"decisions\.map\.regret_steps: \[70\]"),
         ("decisions.map.track_loss_error", 0, r"decisions\.map\.track_loss_error: 0 "),
         ("decisions.map.bootstrap", 10, r"decisions\.map\.bootstrap: 10 "),

@@ -207,3 +207,17 @@ def test_regret_summary_and_claims():
     v = {c.id: c.verdict for c in dec.uav_claims(df, summary, pd.DataFrame(), 1, 500)}
     assert v["DEC-6"] == "supported"  # NBO within the margin of RS-MHP in the reconstruction
     assert v["DEC-7-fp150"] == "supported"  # RS-MHP decides better with the footprint
+
+
+def test_limited_cells_follow_the_axis_else_the_base_sensor():
+    m = pd.DataFrame(
+        {
+            "row_key": ["sensor.footprint_radius"] * 2 + ["target.q"] * 2,
+            "row_value": [None, 150.0, 1.0, 4.0],
+            "col_key": ["target.q"] * 2 + ["tracker.p0_pos_sd"] * 2,
+            "col_value": [1.0, 1.0, 10.0, 50.0],
+        }
+    )
+    assert dec._limited(m).tolist() == [False, True, False, False]
+    # a base footprint applies where no axis sets the radius; a null axis value overrides it
+    assert dec._limited(m, base_limited=True).tolist() == [False, True, True, True]

@@ -140,6 +140,11 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
         if isinstance(methods, Mapping) and methods:
             n = bool(methods.get("nbo", True)) + len(methods.get("rsmhp_nt", []) or [])
             n += len(methods.get("tree", []) or [])
+            if methods.get("nbo") is False:
+                problems.append(
+                    f"decisions.{section}.methods.nbo: false (allowed: true; NBO is the "
+                    "baseline every comparison of the decision study is made against)"
+                )
             if n < 2 and section == "map":
                 problems.append(
                     "decisions.map.methods: fewer than 2 methods (allowed: NBO and at least "

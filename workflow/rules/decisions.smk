@@ -146,6 +146,7 @@ rule decisions_uav_summary:
         runtime=10,
     params:
         cfg=canonical(DEC),
+        base_limited=config["uav"]["sensor"]["footprint_radius"] is not None,
         seed=config["seed"],
     script:
         "../scripts/decisions_uav_summary.py"

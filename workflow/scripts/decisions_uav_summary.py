@@ -24,5 +24,7 @@ with rule_logging(snakemake.log[0], snakemake.rule):
     write_csv(map_df, snakemake.output.map)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
-    section = analysis.uav_decision_section(regret, summary, map_df, tables, cfg, seed)
+    section = analysis.uav_decision_section(
+        regret, summary, map_df, tables, cfg, seed, snakemake.params.base_limited
+    )
     section.save(snakemake.output.section)

@@ -124,7 +124,8 @@ def merge_variant(uav: Mapping[str, Any], variant: Mapping[str, Any]) -> dict[st
             continue
         if section not in ("sensor", "target", "tracker"):
             raise ValueError(
-                f"model variant: unknown section {section!r} (allowed: sensor, target, tracker)"
+                f"decisions model variant: unknown section {section!r} "
+                "(allowed: sensor, target, tracker)"
             )
         out[section] = {**out.get(section, {}), **dict(values)}
     return out
@@ -151,7 +152,8 @@ def belief_states(
     wanted = sorted(set(int(s) for s in steps))
     if wanted and wanted[-1] >= setup.steps:
         raise ValueError(
-            f"belief-state step {wanted[-1]} is not before the run's last step {setup.steps}"
+            f"belief-state step {wanted[-1]} (decisions.uav.steps / decisions.map.regret_steps) "
+            f"is not before the run's last step (uav.scenario.steps = {setup.steps})"
         )
     nbo = MethodSpec("nbo", "nbo", 1)
     out: list[BeliefState] = []

@@ -131,12 +131,12 @@ def uav_map_figure(map_df: pd.DataFrame) -> plt.Figure:
     fig, axes = plt.subplots(1, len(comps), figsize=(5.6 * len(comps), 4.6), squeeze=False)
     row_key, col_key = map_df["row_key"].iloc[0], map_df["col_key"].iloc[0]
     rows = list(dict.fromkeys(map_df["row_value"].map(lambda v: "∞" if pd.isna(v) else f"{v:g}")))
-    cols = list(dict.fromkeys(map_df["col_value"].map(lambda v: f"{v:g}")))
+    cols = list(dict.fromkeys(map_df["col_value"].map(lambda v: "∞" if pd.isna(v) else f"{v:g}")))
     lim = float(np.nanmax(np.abs(map_df["mean_diff"]))) or 1.0
     for ax, comp in zip(axes[0], comps, strict=True):
         sub = map_df[map_df["comparison"] == comp].assign(
             r=lambda d: d["row_value"].map(lambda v: "∞" if pd.isna(v) else f"{v:g}"),
-            c=lambda d: d["col_value"].map(lambda v: f"{v:g}"),
+            c=lambda d: d["col_value"].map(lambda v: "∞" if pd.isna(v) else f"{v:g}"),
         )
         grid = sub.pivot(index="r", columns="c", values="mean_diff").loc[rows, cols]
         sig = (sub["ci_high"] < 0) | (sub["ci_low"] > 0)
