@@ -22,8 +22,9 @@ $(STAMP): pyproject.toml
 
 setup: $(STAMP)
 
+# extra snakemake flags: make replicate ARGS="--rerun-incomplete"
 replicate: $(STAMP)
-	$(BIN)/snakemake -j$(CORES)
+	$(BIN)/snakemake -j$(CORES) $(ARGS)
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

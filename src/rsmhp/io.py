@@ -51,13 +51,31 @@ def read_table(
     return df
 
 
+def _umask() -> int:
+    """The process umask (read from /proc where available, which changes nothing; else set
+    and restored at once)."""
+    try:
+        for line in Path("/proc/self/status").read_text().splitlines():
+            if line.startswith("Umask:"):
+                return int(line.split()[1], 8)
+    except OSError:
+        pass
+    mask = os.umask(0o022)
+    os.umask(mask)
+    return mask
+
+
 def _atomic(path: str | os.PathLike, write) -> None:
+    """Write through a temporary file in the target directory, then rename it over ``path``
+    (a reader never sees a half-written file; a failed write leaves the old file). The file
+    gets the mode an ordinary ``open`` would give (0666 minus the umask), not mkstemp's 0600."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
     os.close(fd)
     try:
         write(tmp)
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
