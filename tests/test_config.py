@@ -175,3 +175,72 @@ def test_bad_uav_values_are_named(path, value, expected):
 def test_bad_decision_values_are_named(path, value, expected):
     with pytest.raises(ConfigError, match=expected):
         check_config(_with(path, value))
+
+
+def _filled_default() -> dict:
+    """The default config with the schema's defaults filled in (as the Snakefile sees it)."""
+    from snakemake.utils import validate
+
+    cfg = copy.deepcopy(DEFAULT)
+    validate(cfg, str(ROOT / "workflow" / "schemas" / "config.schema.yaml"))
+    return cfg
+
+
+def _numeric_leaves(schema: dict, node, path: tuple = ()):
+    """(path, kind) of every numeric field of the schema present in ``node``; kind is
+    'integer' or 'number'; array elements as index 0."""
+    types = schema.get("type")
+    types = types if isinstance(types, list) else [types]
+    if "object" in types and isinstance(node, dict):
+        for key, sub in schema.get("properties", {}).items():
+            if key in node:
+                yield from _numeric_leaves(sub, node[key], (*path, key))
+    elif "array" in types and isinstance(node, list) and node:
+        yield from _numeric_leaves(schema.get("items", {}), node[0], (*path, 0))
+    elif "integer" in types and not isinstance(node, bool):
+        yield path, "integer"
+    elif "number" in types and not isinstance(node, bool):
+        yield path, "number"
+
+
+def _dotted(path: tuple) -> str:
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path).lstrip(".")
+
+
+SCHEMA = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
+FILLED = _filled_default()
+
+
+def _bad_numeric_cases():
+    schema, cfg = SCHEMA, FILLED
+    cases = []
+    for path, kind in _numeric_leaves(schema, cfg):
+        cases.append((path, float("nan")))
+        cases.append((path, float("inf")))
+        if kind == "integer":
+            node = cfg
+            for p in path:
+                node = node[p]
+            cases.append((path, float(node)))  # a whole-number float, e.g. 7.0
+    return cases
+
+
+BAD_NUMERIC = _bad_numeric_cases()
+
+
+def test_the_numeric_matrix_is_large():
+    assert len(BAD_NUMERIC) >= 200  # every numeric field of the schema, three ways
+
+
+@pytest.mark.parametrize(
+    ("path", "value"), BAD_NUMERIC, ids=[f"{_dotted(p)}={v!r}" for p, v in BAD_NUMERIC]
+)
+def test_nan_inf_and_float_integers_are_refused_by_name(path, value):
+    cfg = copy.deepcopy(FILLED)
+    node = cfg
+    for p in path[:-1]:
+        node = node[p]
+    node[path[-1]] = value
+    with pytest.raises(ConfigError) as exc:
+        check_config(cfg, SCHEMA)
+    assert f"{_dotted(path)}: {value!r}" in str(exc.value)

@@ -205,6 +205,8 @@ def test_up_to_date_and_figure_change_reruns_no_simulation(run_j2, tmp_path, tin
         ({"lqg": {"recording": {"N": 2, "M": 5}}}, "lqg.recording.M"),
         ({"estimators": {"recording": {"N": 2, "M": 3}}}, "estimators.recording.M"),
         ({"estimators": {"budgets": [16, 48]}}, "estimators.budgets"),
+        ({"uav": {"target": {"q": float("nan")}}}, "uav.target.q"),
+        ({"seed": 7.0}, "seed"),
     ],
 )
 def test_invalid_config_fails_before_any_job(run_j2, tmp_path, override, field):

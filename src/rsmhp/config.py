@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import Any
 
 import yaml
-from jsonschema import Draft202012Validator
+from jsonschema import Draft202012Validator, validators
 from jsonschema.exceptions import ValidationError
 
 __all__ = ["SCHEMA_PATH", "ConfigError", "check_config", "load_schema"]
@@ -256,6 +256,41 @@ def _estimator_problems(problems: list[Mapping[str, Any]]) -> list[str]:
     return out
 
 
+def _strict_integer(checker, instance) -> bool:
+    """JSON Schema's "integer" without whole-number floats: ``seed: 7.0`` or ``chunks: 2.0``
+    are refused (they would otherwise reach names and seeds as floats)."""
+    return isinstance(instance, int) and not isinstance(instance, bool)
+
+
+def _finite_number(checker, instance) -> bool:
+    """JSON Schema's "number" without NaN and infinity (YAML's ``.nan``, ``.inf``)."""
+    return (
+        isinstance(instance, int | float)
+        and not isinstance(instance, bool)
+        and math.isfinite(instance)
+    )
+
+
+_Validator = validators.extend(
+    Draft202012Validator,
+    type_checker=Draft202012Validator.TYPE_CHECKER.redefine_many(
+        {"integer": _strict_integer, "number": _finite_number}
+    ),
+)
+
+
+def _non_finite(node: Any, path: tuple = ()) -> list[str]:
+    """Every NaN or infinite float anywhere in the config (also where the schema allows any
+    value), as a message naming its key."""
+    if isinstance(node, float) and not math.isfinite(node):
+        return [f"{_dotted(path)}: {node!r} is not a finite number (allowed: finite numbers)"]
+    if isinstance(node, Mapping):
+        return [m for k, v in node.items() for m in _non_finite(v, (*path, k))]
+    if isinstance(node, list | tuple):
+        return [m for i, v in enumerate(node) for m in _non_finite(v, (*path, i))]
+    return []
+
+
 def check_config(
     config: Mapping[str, Any], schema: Mapping[str, Any] | str | os.PathLike | None = None
 ) -> None:
@@ -265,11 +300,13 @@ def check_config(
     """
     if not isinstance(schema, Mapping):
         schema = load_schema(schema)
-    validator = Draft202012Validator(schema)
+    validator = _Validator(schema)
     errors = sorted(
         validator.iter_errors(dict(config)), key=lambda e: list(map(str, e.absolute_path))
     )
-    problems = [_message(e) for e in errors]
+    problems = _non_finite(config)
+    flagged = {p.split(":")[0] for p in problems}
+    problems += [m for m in map(_message, errors) if m.split(":")[0] not in flagged]
     if not problems:
         problems = _cross_field(config)
     if problems:
