@@ -244,3 +244,19 @@ def test_nan_inf_and_float_integers_are_refused_by_name(path, value):
     with pytest.raises(ConfigError) as exc:
         check_config(cfg, SCHEMA)
     assert f"{_dotted(path)}: {value!r}" in str(exc.value)
+
+
+@pytest.mark.parametrize(
+    ("path", "value", "expected"),
+    [
+        ("lqg.convergence.P", {"start": 100, "stop": 200, "step": 100}, r"gives 2 value"),
+        ("lqg.convergence.P", {"start": 100, "stop": 100, "step": 100}, r"gives 1 value"),
+        ("estimators.schemes", ["nbo"], r"estimators\.schemes: \['nbo'\] has no mc"),
+        ("estimators.tree_N", [100, 200], r"estimators\.tree_N: no N in \[100, 200\]"),
+        ("uav.methods", {"nbo": False, "rsmhp_nt": [], "tree": []}, r"uav\.methods: 0 method"),
+        ("uav.methods", {"nbo": True, "rsmhp_nt": [], "tree": []}, r"uav\.methods: 1 method"),
+    ],
+)
+def test_configs_with_nothing_to_compare_are_refused(path, value, expected):
+    with pytest.raises(ConfigError, match=expected):
+        check_config(_with(path, value))

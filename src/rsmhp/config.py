@@ -110,8 +110,53 @@ def _cross_field(config: Mapping[str, Any]) -> list[str]:
         val = (lqg.get("model", {}) or {}).get(key)
         if isinstance(val, float) and not math.isfinite(val):
             problems.append(f"lqg.model.{key}: {val} is not finite")
+    problems += _nothing_to_run(config)
     problems += _uav_cross_field(config.get("uav", {}) or {})
     problems += _decisions_cross_field(config)
+    return problems
+
+
+def _nothing_to_run(config: Mapping[str, Any]) -> list[str]:
+    """Configs that validate field by field but leave an analysis without its inputs (they
+    used to fail after the simulations)."""
+    problems = []
+    grid = ((config.get("lqg", {}) or {}).get("convergence", {}) or {}).get("P", {}) or {}
+    if {"start", "stop", "step"} <= grid.keys() and grid["step"] > 0:
+        n_p = len(range(int(grid["start"]), int(grid["stop"]) + 1, int(grid["step"])))
+        if n_p < 3:
+            problems.append(
+                f"lqg.convergence.P: {{start: {grid['start']}, stop: {grid['stop']}, step: "
+                f"{grid['step']}}} gives {n_p} value(s) (allowed: at least 3, for the error "
+                "slope in P)"
+            )
+    est = config.get("estimators", {}) or {}
+    schemes = est.get("schemes") or []
+    if schemes and "mc" not in schemes:
+        problems.append(
+            f"estimators.schemes: {schemes} has no mc (allowed: any list containing mc, the "
+            "reference every estimator is compared with)"
+        )
+    tree_n, max_leaves = est.get("tree_N") or [], est.get("max_leaves")
+    horizons = [
+        len(spec["u"]) for spec in est.get("problems") or [] if isinstance(spec.get("u"), list)
+    ]
+    if {"tree", "tree_pernode"} & set(schemes) and tree_n and max_leaves and horizons:
+        if not any(n**h <= max_leaves for n in tree_n for h in horizons):
+            problems.append(
+                f"estimators.tree_N: no N in {tree_n} gives a tree with N^H <= "
+                f"estimators.max_leaves = {max_leaves} for any problem (H in "
+                f"{sorted(set(horizons))}) (allowed: at least one such N, or drop tree and "
+                "tree_pernode from estimators.schemes)"
+            )
+    methods = (config.get("uav", {}) or {}).get("methods")
+    if isinstance(methods, Mapping):
+        n = bool(methods.get("nbo", True)) + len(methods.get("rsmhp_nt") or [])
+        n += len(methods.get("tree") or [])
+        if n < 2:
+            problems.append(
+                f"uav.methods: {n} method(s) (allowed: at least 2, e.g. nbo and one rsmhp_nt, "
+                "so that there is a comparison)"
+            )
     return problems
 
 
