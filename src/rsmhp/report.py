@@ -24,6 +24,7 @@ __all__ = [
     "VERDICTS",
     "Claim",
     "Section",
+    "claims_list",
     "claims_table",
     "markdown_table",
     "provenance",
@@ -84,6 +85,12 @@ def markdown_table(df: pd.DataFrame, floatfmt: str = ".4g") -> str:
     """Markdown table without index; integer columns in full, floats with ``floatfmt``."""
     fmts = ["d" if pd.api.types.is_integer_dtype(t) else floatfmt for t in df.dtypes]
     return df.to_markdown(index=False, floatfmt=fmts)
+
+
+def claims_list(claims: Iterable[Claim]) -> list[str]:
+    """One Markdown bullet per claim, ``- **ID** (verdict): claim. Measured: ...``, for a
+    section's "Claims" list."""
+    return [f"- **{c.id}** ({c.verdict}): {c.claim}. Measured: {c.measured}." for c in claims]
 
 
 def claims_table(claims: Iterable[Claim]) -> str:

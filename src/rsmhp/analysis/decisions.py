@@ -26,7 +26,9 @@ import pandas as pd
 from scipy import stats as sps
 
 from rsmhp import lqg
-from rsmhp.report import Claim, Section, markdown_table
+from rsmhp.analysis.uav import bootstrap_ci
+from rsmhp.report import Claim, Section, claims_list, markdown_table
+from rsmhp.seeding import job_rng
 from rsmhp.stats import loglog_slope, mean_ci
 
 __all__ = [
@@ -391,7 +393,7 @@ def lqg_decision_section(
             "",
             "### Claims",
             "",
-            *(f"- **{c.id}** ({c.verdict}): {c.claim}. Measured: {c.measured}." for c in claims),
+            *claims_list(claims),
             "",
             "### Figures",
             "",
@@ -480,9 +482,8 @@ EQUIVALENCE_MARGIN = 0.005  # DEC-6: 0.5 percentage points of relative regret, f
 
 
 def _boot_mean(x: np.ndarray, seed: int, n_boot: int, **key: Any) -> tuple[float, float]:
-    from rsmhp.analysis.uav import bootstrap_ci
-    from rsmhp.seeding import job_rng
-
+    """Percentile-bootstrap 95% CI of the mean of ``x``, resampled from a stream keyed on
+    ``key``; NaNs for fewer than 2 values."""
     x = np.asarray(x, dtype=float)
     if x.size < 2:
         return float("nan"), float("nan")
@@ -818,7 +819,7 @@ def uav_decision_section(
             "",
             "### Claims",
             "",
-            *(f"- **{c.id}** ({c.verdict}): {c.claim}. Measured: {c.measured}." for c in claims),
+            *claims_list(claims),
             "",
             "### Figures",
             "",

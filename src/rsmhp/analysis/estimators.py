@@ -36,7 +36,7 @@ import pandas as pd
 
 from rsmhp.experiments.estimators import ABLATION_COLUMNS, build_problem
 from rsmhp.linear_quadratic import LinearQuadratic
-from rsmhp.report import Claim, Section
+from rsmhp.report import Claim, Section, claims_list
 from rsmhp.report import markdown_table as _md
 from rsmhp.seeding import job_rng
 from rsmhp.stats import binomial_ci, loglog_slope
@@ -482,7 +482,7 @@ def estimators_section(
             "",
             "### Claims",
             "",
-            *(f"- **{c.id}** ({c.verdict}): {c.claim}. Measured: {c.measured}." for c in cl),
+            *claims_list(cl),
             "",
             "Why: in the paper's tree every node of a level reuses the same N draws, so the N^H "
             "leaves carry only N·H independent numbers; its variance is "

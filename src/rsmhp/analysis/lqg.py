@@ -29,7 +29,7 @@ from scipy import stats as sps
 
 from rsmhp import lqg
 from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, NBO_ERROR_COLUMNS
-from rsmhp.report import Claim, Section
+from rsmhp.report import Claim, Section, claims_list
 from rsmhp.report import markdown_table as _md
 from rsmhp.stats import binomial_ci, loglog_slope, mean_ci, rmse_ci
 
@@ -353,7 +353,7 @@ def lqg_section(
             "",
             "### Claims",
             "",
-            *(f"- **{c.id}** ({c.verdict}): {c.claim}. Measured: {c.measured}." for c in claims),
+            *claims_list(claims),
             "",
             "The weighted estimator weights each trajectory by the product of its noise densities; "
             "for Gaussian noise that tilts N(0, σ²) to N(0, σ²/2), so it converges to J(σ²/2) = "

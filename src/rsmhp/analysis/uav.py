@@ -35,7 +35,7 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
-from rsmhp.report import Claim, Section
+from rsmhp.report import Claim, Section, claims_list
 from rsmhp.seeding import job_rng
 
 __all__ = [
@@ -362,7 +362,7 @@ def uav_section(
             "",
             "### Claims",
             "",
-            *(f"- **{c.id}** ({c.verdict}): {c.claim}. Measured: {c.measured}." for c in claims),
+            *claims_list(claims),
             "",
             "### Figures",
             "",

@@ -47,13 +47,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 from scipy import stats
-from scipy.optimize import minimize
 from threadpoolctl import threadpool_limits
 
 from rsmhp.parallel import parallel_map
 from rsmhp.seeding import job_rng
 from rsmhp.uav import fused, target
-from rsmhp.uav.planner import PlanningProblem, _box, plan
+from rsmhp.uav.planner import PlanningProblem, lbfgsb, plan
 from rsmhp.uav.simulation import (
     MethodSpec,
     StepInfo,
@@ -184,7 +183,7 @@ def belief_states(
 
 
 def _positions(x: np.ndarray, problem: PlanningProblem) -> np.ndarray:
-    return np.stack([fused.path(xi, problem._frozen)[:, :2] for xi in np.atleast_2d(x)])
+    return np.stack([problem.path(xi)[:, :2] for xi in np.atleast_2d(x)])
 
 
 def score_state(
@@ -219,14 +218,7 @@ def score_state(
     starts += list(aux.uniform(-1.0, 1.0, (int(cfg["random_starts"]), 2 * H)))
     best_x, best_f = cands[int(np.argmin(cand_cost))], float(cand_cost.min())
     for x0 in starts:
-        res = minimize(
-            ev.value_and_grad,
-            x0,
-            jac=True,
-            method="L-BFGS-B",
-            bounds=_box(x0.size),
-            options={"maxiter": int(cfg["eval_maxiter"])},
-        )
+        res = lbfgsb(ev, x0, int(cfg["eval_maxiter"]))
         if res.fun < best_f:
             best_x, best_f = np.clip(res.x, -1.0, 1.0), float(res.fun)
     # per-hypothesis costs c_i of every plan and of the best, on the evaluation set

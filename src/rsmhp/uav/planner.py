@@ -31,7 +31,7 @@ from rsmhp.uav.kinematics import UAVParams
 from rsmhp.uav.sensor import SensorModel
 from rsmhp.uav.target import TargetModel
 
-__all__ = ["PlanResult", "PlannerParams", "PlanningProblem", "plan", "shift_plan"]
+__all__ = ["PlanResult", "PlannerParams", "PlanningProblem", "lbfgsb", "plan", "shift_plan"]
 
 
 @dataclass(frozen=True)
@@ -102,6 +102,10 @@ class PlanningProblem:
         self.n_kernel_calls += 1
         return fused.evaluate(np.atleast_2d(xs), self._frozen, want_grad=False)[0]
 
+    def path(self, x: np.ndarray) -> np.ndarray:
+        """Planned UAV states (H, 4) of one normalised sequence ``x`` (2H,)."""
+        return fused.path(x, self._frozen)
+
     def value_and_grad(self, x: np.ndarray) -> tuple[float, np.ndarray]:
         """``(J(x), grad J(x))`` for one normalised sequence ``x`` (2H,)."""
         x = np.asarray(x, dtype=float)
@@ -127,18 +131,25 @@ def _box(n: int) -> Bounds:
     return Bounds(np.full(n, -1.0), np.full(n, 1.0))
 
 
-def plan(problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
-    """Minimise the problem's cost from ``warm_start`` (H, 2) controls with L-BFGS-B."""
-    x0 = np.clip(np.asarray(warm_start, dtype=float).ravel() / problem.scale, -1.0, 1.0)
-    f0, _ = problem.value_and_grad(x0)
-    res = minimize(
+def lbfgsb(problem: PlanningProblem, x0: np.ndarray, maxiter: int, maxfun: int | None = None):
+    """scipy's L-BFGS-B on ``problem`` (exact gradient) over the box [-1, 1]^2H from ``x0``,
+    at most ``maxiter`` iterations (and ``maxfun`` evaluations if given); the scipy result."""
+    options = {"maxiter": maxiter} if maxfun is None else {"maxiter": maxiter, "maxfun": maxfun}
+    return minimize(
         problem.value_and_grad,
         x0,
         jac=True,
         method="L-BFGS-B",
         bounds=_box(x0.size),
-        options={"maxiter": problem.params.maxiter, "maxfun": problem.params.maxfun},
+        options=options,
     )
+
+
+def plan(problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
+    """Minimise the problem's cost from ``warm_start`` (H, 2) controls with L-BFGS-B."""
+    x0 = np.clip(np.asarray(warm_start, dtype=float).ravel() / problem.scale, -1.0, 1.0)
+    f0, _ = problem.value_and_grad(x0)
+    res = lbfgsb(problem, x0, problem.params.maxiter, problem.params.maxfun)
     x_best, f_best = (res.x, float(res.fun)) if res.fun <= f0 else (x0, f0)
     controls = problem.controls(x_best)
     return PlanResult(
@@ -147,5 +158,5 @@ def plan(problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
         cost_warm=f0,
         nit=int(res.nit),
         n_kernel_calls=problem.n_kernel_calls,
-        uav_path=fused.path(x_best, problem._frozen),
+        uav_path=problem.path(x_best),
     )
