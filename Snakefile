@@ -1,8 +1,9 @@
 # rsmhp: replication pipeline for Ragi & Mittelmann (IEEE L-CSS 2021), RS-MHP vs NBO.
 # Thin entry point: load and validate the config, then include the rule files.
-from snakemake.utils import min_version, validate
+from snakemake.utils import min_version, update_config, validate
 
-from rsmhp.config import check_config
+from rsmhp.config import ConfigError, check_config, load_config_file, typed_overrides
+from rsmhp.resources import memory_problems
 
 min_version("9.0")
 
@@ -18,8 +19,17 @@ os.environ.update(
 )
 
 
+# A broken config/config.yaml is reported with its line (Snakemake only says "not valid
+# YAML"); files given with --configfile are parsed by Snakemake before this file runs:
+# `python -m rsmhp.config FILE` reports their lines.
+load_config_file(os.path.join(workflow.basedir, "config", "config.yaml"))
+
+
 configfile: os.path.join(workflow.basedir, "config", "config.yaml")
 
+
+# Nested --config values arrive as strings ("0.3"); give them their YAML types.
+update_config(config, typed_overrides(workflow.config_settings.config))
 
 # Friendly, complete error list first (names every field and its allowed range) ...
 check_config(
@@ -37,6 +47,16 @@ include: "workflow/rules/estimators.smk"
 include: "workflow/rules/uav.smk"
 include: "workflow/rules/decisions.smk"
 include: "workflow/rules/report.smk"
+
+
+# Memory: every simulation rule's estimate for this config within its mem_mb, before any job.
+_memory = memory_problems(
+    config, {r.name: getattr(r.resources.get("mem_mb"), "raw", None) for r in workflow.rules}
+)
+if _memory:
+    raise ConfigError(
+        "invalid configuration (nothing was run):\n  - " + "\n  - ".join(_memory)
+    )
 
 
 rule all:

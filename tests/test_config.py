@@ -260,3 +260,77 @@ def test_nan_inf_and_float_integers_are_refused_by_name(path, value):
 def test_configs_with_nothing_to_compare_are_refused(path, value, expected):
     with pytest.raises(ConfigError, match=expected):
         check_config(_with(path, value))
+
+
+# ------------------------------------------------------------ config files and overrides
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("seed: 7\nlqg:\n  model: {a: 0.5\n  x: 1\n", r"bad\.yaml:4:4: not valid YAML"),
+        ("seed: 7\n  lqg: 3\n", r"bad\.yaml:2:6: not valid YAML \(mapping values are not allowed"),
+        ("seed: 7\nseed:\t8\n", r"bad\.yaml:2:\d+: not valid YAML"),
+        ("", r"bad\.yaml: the file is empty \(allowed: a YAML mapping"),
+        ("# only a comment\n", r"bad\.yaml: the file is empty"),
+        ("- seed\n- 7\n", r"bad\.yaml: the top level is a list, not a mapping"),
+        ("7\n", r"bad\.yaml: the top level is a int, not a mapping"),
+    ],
+)
+def test_config_files_are_refused_with_file_and_line(tmp_path, text, message):
+    from rsmhp.config import load_config_file
+
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError, match=message):
+        load_config_file(path)
+
+
+def test_missing_config_file_is_named(tmp_path):
+    from rsmhp.config import load_config_file
+
+    with pytest.raises(ConfigError, match=r"nope\.yaml: cannot be read"):
+        load_config_file(tmp_path / "nope.yaml")
+
+
+def test_config_cli_checks_an_overlay(tmp_path, capsys):
+    from rsmhp.config import main
+
+    good = tmp_path / "good.yaml"
+    good.write_text("lqg:\n  model: {a: 0.3}\n")
+    assert main([str(good)]) == 0
+    assert "valid" in capsys.readouterr().out
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("lqg:\n  model: {a: 1.3}\nuav:\n  runs: 2.0\n")
+    assert main([str(bad)]) == 1
+    err = capsys.readouterr().err
+    assert "lqg.model.a: 1.3" in err and "uav.runs: 2.0" in err
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("lqg: [1, 2\n")
+    assert main([str(broken)]) == 1
+    assert "broken.yaml:2:1: not valid YAML" in capsys.readouterr().err
+
+
+def test_nested_command_line_overrides_get_their_yaml_types():
+    from rsmhp.config import typed_overrides
+
+    # what Snakemake hands over for --config seed=3 'lqg={model: {a: 0.3, x0: null}}'
+    # 'uav={methods: {rsmhp_nt: [10, 50]}, sensor: {detection: logistic}}'
+    raw = {
+        "seed": 3,
+        "lqg": {"model": {"a": "0.3", "x0": "null"}},
+        "uav": {"methods": {"rsmhp_nt": ["10", "50"]}, "sensor": {"detection": "logistic"}},
+    }
+    assert typed_overrides(raw) == {
+        "seed": 3,
+        "lqg": {"model": {"a": 0.3, "x0": None}},
+        "uav": {"methods": {"rsmhp_nt": [10, 50]}, "sensor": {"detection": "logistic"}},
+    }
+
+
+def test_merge_follows_snakemakes_overlay_rule():
+    from rsmhp.config import merge
+
+    base = {"a": {"b": 1, "c": [1, 2]}, "d": 1}
+    assert merge(base, {"a": {"c": [3]}}) == {"a": {"b": 1, "c": [3]}, "d": 1}
+    assert base == {"a": {"b": 1, "c": [1, 2]}, "d": 1}

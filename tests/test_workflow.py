@@ -221,6 +221,33 @@ def test_invalid_config_fails_before_any_job(run_j2, tmp_path, override, field):
     assert digest(run_j2) == before
 
 
+def test_nested_command_line_override_is_applied(run_j2):
+    """README's override syntax: a nested YAML value after --config, typed like the file."""
+    res = snakemake(run_j2, "-n", "--config", "lqg={model: {a: 0.3}}")
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-2000:]
+    assert "rule lqg_convergence" in out and "rule uav_simulate" not in out  # params changed
+    res = snakemake(run_j2, "-n", "--config", "lqg={model: {a: 1.3}}")
+    out = res.stdout + res.stderr
+    assert res.returncode != 0 and "lqg.model.a: 1.3" in out and "rule lqg_" not in out
+
+
+def test_config_beyond_a_rules_memory_is_refused_before_any_job(run_j2, tmp_path):
+    before = digest(run_j2)
+    big = tmp_path / "big.yaml"
+    big.write_text("lqg:\n  nbo_error: {P: 10000000, H_values: [200]}\n")
+    res = snakemake(run_j2, "-j2", configfiles=(TINY, big))
+    out = res.stdout + res.stderr
+    assert res.returncode != 0
+    assert "lqg_nbo_error: needs about" in out and "lqg.nbo_error.P" in out
+    assert "Select jobs to execute" not in out and digest(run_j2) == before
+    # a machine with the memory: raise the rule's mem_mb and the plan goes through
+    res = snakemake(
+        run_j2, "-n", "--set-resources", "lqg_nbo_error:mem_mb=300000", configfiles=(TINY, big)
+    )
+    assert res.returncode == 0 and "rule lqg_nbo_error" in res.stdout + res.stderr
+
+
 def test_decision_study_outputs(run_j2, tiny, tmp_path):
     cfg = tiny["decisions"]["lqg"]
     df = pd.read_csv(run_j2 / "results/decisions/lqg_regret.csv")

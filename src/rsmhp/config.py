@@ -10,8 +10,10 @@
 
 from __future__ import annotations
 
+import copy
 import math
 import os
+import sys
 from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
@@ -20,9 +22,20 @@ import yaml
 from jsonschema import Draft202012Validator, validators
 from jsonschema.exceptions import ValidationError
 
-__all__ = ["SCHEMA_PATH", "ConfigError", "check_config", "load_schema"]
+__all__ = [
+    "CONFIG_PATH",
+    "SCHEMA_PATH",
+    "ConfigError",
+    "check_config",
+    "load_config_file",
+    "load_schema",
+    "merge",
+    "typed_overrides",
+]
 
-SCHEMA_PATH = Path(__file__).resolve().parents[2] / "workflow" / "schemas" / "config.schema.yaml"
+ROOT = Path(__file__).resolve().parents[2]
+SCHEMA_PATH = ROOT / "workflow" / "schemas" / "config.schema.yaml"
+CONFIG_PATH = ROOT / "config" / "config.yaml"
 
 
 class ConfigError(ValueError):
@@ -32,6 +45,76 @@ class ConfigError(ValueError):
 def load_schema(path: str | os.PathLike | None = None) -> dict[str, Any]:
     with open(path or SCHEMA_PATH, encoding="utf-8") as fh:
         return yaml.safe_load(fh)
+
+
+def load_config_file(path: str | os.PathLike) -> dict[str, Any]:
+    """Parse one YAML config file; :class:`ConfigError` names the file, line and column of a
+    syntax error, and refuses an empty file or one whose top level is not a mapping."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise ConfigError(f"{path}: cannot be read ({exc.strerror})") from exc
+    try:
+        data = yaml.safe_load(text)
+    except yaml.YAMLError as exc:
+        mark = getattr(exc, "problem_mark", None)
+        where = f"{path}:{mark.line + 1}:{mark.column + 1}" if mark else str(path)
+        what = " ".join(
+            str(p) for p in (getattr(exc, "context", None), getattr(exc, "problem", None)) if p
+        )
+        raise ConfigError(
+            f"{where}: not valid YAML ({what or exc}); check the indentation and the brackets "
+            "on that line and the one before"
+        ) from exc
+    if data is None:
+        raise ConfigError(
+            f"{path}: the file is empty (allowed: a YAML mapping of config keys, e.g. "
+            "'seed: 7'; see config/config.yaml)"
+        )
+    if not isinstance(data, dict):
+        raise ConfigError(
+            f"{path}: the top level is a {type(data).__name__}, not a mapping of config keys "
+            "(allowed: e.g. 'seed: 7' on its own line)"
+        )
+    return data
+
+
+def merge(base: Mapping[str, Any], overlay: Mapping[str, Any]) -> dict[str, Any]:
+    """Snakemake's overlay rule: mappings merge key by key, anything else (lists included)
+    replaces the base value."""
+    out = copy.deepcopy(dict(base))
+    for key, value in overlay.items():
+        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
+            out[key] = merge(out[key], value)
+        else:
+            out[key] = copy.deepcopy(value)
+    return out
+
+
+def typed_overrides(overrides: Mapping[str, Any]) -> dict[str, Any]:
+    """Give nested ``--config`` values their YAML types.
+
+    Snakemake parses ``--config key=value`` with int, float, bool and then YAML's
+    *BaseLoader*, which keeps every nested scalar a string: ``--config 'lqg={model: {a:
+    0.3}}'`` arrives as ``{"model": {"a": "0.3"}}``. Below the top level this re-reads each
+    string with ``yaml.safe_load`` (``"0.3"`` -> 0.3, ``"null"`` -> None, ``"[1, 2]"`` -> a
+    list); top-level values, already typed by Snakemake, are kept.
+    """
+
+    def retype(value: Any) -> Any:
+        if isinstance(value, Mapping):
+            return {k: retype(v) for k, v in value.items()}
+        if isinstance(value, list):
+            return [retype(v) for v in value]
+        if isinstance(value, str):
+            try:
+                return yaml.safe_load(value)
+            except yaml.YAMLError:
+                return value
+        return value
+
+    return {k: retype(v) if isinstance(v, Mapping | list) else v for k, v in overrides.items()}
 
 
 def _dotted(path) -> str:
@@ -358,3 +441,25 @@ def check_config(
         raise ConfigError(
             "invalid configuration (nothing was run):\n  - " + "\n  - ".join(problems)
         )
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``python -m rsmhp.config [FILE ...]``: check config files as the workflow would use
+    them (``config/config.yaml`` overlaid by each FILE in order, then every check of
+    :func:`check_config`); print every problem with its file and line or key. Exit status 0
+    if valid, 1 if not."""
+    files = [Path(a) for a in (sys.argv[1:] if argv is None else argv)]
+    try:
+        config = load_config_file(CONFIG_PATH)
+        for f in files:
+            config = merge(config, load_config_file(f))
+        check_config(config)
+    except ConfigError as exc:
+        print(exc, file=sys.stderr)
+        return 1
+    print(f"valid: {', '.join(map(str, [CONFIG_PATH, *files]))}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

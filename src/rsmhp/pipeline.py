@@ -17,9 +17,17 @@ __all__ = ["rule_logging"]
 def rule_logging(log_path: str | os.PathLike, rule: str) -> Iterator[logging.Logger]:
     """Send ``logging`` (INFO and up) to ``log_path`` and stderr for the duration of a rule script.
 
-    Any exception is logged with its traceback, then re-raised so Snakemake marks the job
-    failed (and removes its partial outputs; outputs are written atomically anyway).
+    An *expected* failure (a corrupt or incomplete intermediate,
+    :class:`rsmhp.io.IntermediateFileError`; an invalid configuration,
+    :class:`rsmhp.config.ConfigError`) is logged as its message alone and ends the script with
+    exit status 1: the message names the file or key and what to do, a traceback would only
+    bury it. Any other exception is logged with its traceback and re-raised (a bug). Either
+    way Snakemake marks the job failed (and removes its outputs; they are written atomically,
+    so no half-written file is ever left).
     """
+    from rsmhp.config import ConfigError
+    from rsmhp.io import IntermediateFileError
+
     Path(log_path).parent.mkdir(parents=True, exist_ok=True)
     handlers = [
         logging.FileHandler(log_path, mode="w", encoding="utf-8"),
@@ -36,6 +44,9 @@ def rule_logging(log_path: str | os.PathLike, rule: str) -> Iterator[logging.Log
     log.info("start")
     try:
         yield log
+    except (IntermediateFileError, ConfigError) as exc:
+        log.error("failed: %s", exc)
+        raise SystemExit(1) from None
     except Exception:
         log.exception("failed")
         raise

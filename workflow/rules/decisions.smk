@@ -169,6 +169,8 @@ rule decisions_figures:
     resources:
         mem_mb=2000,
         runtime=5,
+    params:
+        cfg=canonical(DEC["uav"]),
     script:
         "../scripts/decisions_figures.py"
 

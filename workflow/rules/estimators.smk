@@ -76,6 +76,7 @@ rule estimators_summary:
         model=canonical(config["lqg"]["model"]),
         ks=config["estimators"]["chebyshev_k"],
         seed=config["seed"],
+        estimators=EST_SIM,
     script:
         "../scripts/estimators_summary.py"
 

@@ -6,6 +6,12 @@ LQG_TABLES = ["lqg_convergence", "lqg_nbo_error", "lqg_chebyshev"]
 LQG_FIGURES = ["lqg_convergence", "lqg_error_loglog", "lqg_nbo_error"]
 REPORT_SECTIONS["lqg"] = "results/report/lqg.json"
 REPORT_FIGURES.extend(LQG_FIGURES)
+# what the simulations were asked for: the aggregation rules check their inputs against it
+LQG_SIM = {
+    "model": pick(config["lqg"]["model"], "a", "x0", "r", "target", "sigma"),
+    "convergence": pick(config["lqg"]["convergence"], "u", "P", "replicates"),
+    "nbo_error": canonical(config["lqg"]["nbo_error"]),
+}
 
 
 rule lqg_convergence:
@@ -73,6 +79,8 @@ rule lqg_summary:
         runtime=5,
     params:
         eps=config["lqg"]["convergence"]["chebyshev_eps"],
+        # the inputs are checked against what the simulations were asked for
+        lqg=LQG_SIM,
     script:
         "../scripts/lqg_summary.py"
 
@@ -96,6 +104,7 @@ rule lqg_figures:
         runtime=5,
     params:
         eps=config["lqg"]["convergence"]["chebyshev_eps"],
+        lqg=LQG_SIM,
     script:
         "../scripts/lqg_figures.py"
 

@@ -78,6 +78,12 @@ rule uav_collect:
         runtime=5,
     params:
         methods=UAV_METHODS,
+        # each chunk is checked against what its simulation was asked for
+        specs={m: dataclasses.asdict(s) for m, s in UAV_SPECS.items()},
+        runs=UAV["runs"],
+        chunks=len(UAV_CHUNKS),
+        steps=UAV["scenario"]["steps"],
+        seed=config["seed"],
     script:
         "../scripts/uav_collect.py"
 
@@ -104,6 +110,8 @@ rule uav_summary:
         analysis=canonical(UAV["analysis"]),
         setting=pick(UAV, *UAV_MODEL_KEYS),
         seed=config["seed"],
+        methods=UAV_METHODS,
+        runs=UAV["runs"],
     script:
         "../scripts/uav_summary.py"
 
@@ -125,6 +133,10 @@ rule uav_figures:
     resources:
         mem_mb=2000,
         runtime=5,
+    params:
+        methods=UAV_METHODS,
+        runs=UAV["runs"],
+        seed=config["seed"],
     script:
         "../scripts/uav_figures.py"
 

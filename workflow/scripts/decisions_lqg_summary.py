@@ -3,13 +3,14 @@
 from pathlib import Path
 
 from rsmhp.analysis import decisions as analysis
-from rsmhp.experiments.decisions_lqg import LQG_REGRET_COLUMNS
-from rsmhp.io import read_table, write_csv, write_text
+from rsmhp.contracts import read_checked
+from rsmhp.experiments.decisions_lqg import regret_contract
+from rsmhp.io import write_csv, write_text
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake.log[0], snakemake.rule):
     model = snakemake.params.model
-    df = read_table(snakemake.input[0], LQG_REGRET_COLUMNS)
+    df = read_checked(snakemake.input[0], regret_contract(snakemake.params.cfg))
     summary = analysis.summarize_lqg_regret(df, model)
     scaling = analysis.lqg_scaling(summary)
     tables = analysis.lqg_tables(summary, scaling)

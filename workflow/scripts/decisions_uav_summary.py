@@ -5,17 +5,27 @@ from pathlib import Path
 import pandas as pd
 
 from rsmhp.analysis import decisions as analysis
-from rsmhp.experiments.decisions_uav import MAP_RUN_COLUMNS, REGRET_COLUMNS
-from rsmhp.io import read_table, write_csv, write_text
+from rsmhp.contracts import read_checked
+from rsmhp.experiments.decisions_uav import map_contracts, regret_contract
+from rsmhp.io import write_csv, write_text
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake.log[0], snakemake.rule):
     cfg, seed = snakemake.params.cfg, snakemake.params.seed
     n_boot = int(cfg["map"]["bootstrap"])
-    regret = read_table(snakemake.input.regret, REGRET_COLUMNS)
-    map_runs = pd.concat([read_table(p, MAP_RUN_COLUMNS) for p in snakemake.input.map_runs])
+    regret = read_checked(snakemake.input.regret, regret_contract(cfg["uav"]))
+    # results/decisions/map/<cell>.csv and <cell>_regret.csv, checked against the cell's config
+    map_runs = pd.concat(
+        [
+            read_checked(p, map_contracts(cfg["map"], Path(p).stem)[0])
+            for p in snakemake.input.map_runs
+        ]
+    )
     map_regret = pd.concat(
-        [read_table(p, REGRET_COLUMNS, min_rows=0) for p in snakemake.input.map_regret]
+        [
+            read_checked(p, map_contracts(cfg["map"], Path(p).stem.removesuffix("_regret"))[1])
+            for p in snakemake.input.map_regret
+        ]
     )
     summary = analysis.summarize_uav_regret(regret, seed, n_boot)
     map_df = analysis.summarize_map(map_runs, map_regret, cfg["map"], seed, n_boot)

@@ -3,13 +3,15 @@
 from pathlib import Path
 
 from rsmhp.analysis import estimators as analysis
-from rsmhp.experiments.estimators import ABLATION_COLUMNS
-from rsmhp.io import read_table, write_csv, write_text
+from rsmhp.contracts import read_checked
+from rsmhp.experiments.estimators import ablation_contract
+from rsmhp.io import write_csv, write_text
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake.log[0], snakemake.rule):
     ks = list(snakemake.params.ks)
-    df = read_table(snakemake.input.ablation, ABLATION_COLUMNS)
+    contract = ablation_contract(snakemake.params.estimators, snakemake.params.model)
+    df = read_checked(snakemake.input.ablation, contract)
     problems = analysis.problems_from_config(
         {"problems": snakemake.params.problems}, snakemake.params.model
     )

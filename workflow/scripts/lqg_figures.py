@@ -2,7 +2,8 @@
 
 from pathlib import Path
 
-from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS
+from rsmhp.contracts import read_checked
+from rsmhp.experiments.lqg import convergence_contract
 from rsmhp.figures import lqg as figs
 from rsmhp.figures import save_figure
 from rsmhp.io import read_table
@@ -10,7 +11,7 @@ from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake.log[0], snakemake.rule):
     eps = list(snakemake.params.eps)
-    conv = read_table(snakemake.input.convergence, CONVERGENCE_COLUMNS)
+    conv = read_checked(snakemake.input.convergence, convergence_contract(snakemake.params.lqg))
     summary = read_table(
         snakemake.input.summary,
         [

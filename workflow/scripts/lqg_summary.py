@@ -3,14 +3,16 @@
 from pathlib import Path
 
 from rsmhp.analysis import lqg as analysis
-from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, NBO_ERROR_COLUMNS
-from rsmhp.io import read_table, write_csv, write_text
+from rsmhp.contracts import read_checked
+from rsmhp.experiments.lqg import convergence_contract, nbo_error_contract
+from rsmhp.io import write_csv, write_text
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake.log[0], snakemake.rule):
     eps = list(snakemake.params.eps)
-    conv = read_table(snakemake.input.convergence, CONVERGENCE_COLUMNS)
-    nbo = read_table(snakemake.input.nbo_error, NBO_ERROR_COLUMNS)
+    sim = snakemake.params.lqg
+    conv = read_checked(snakemake.input.convergence, convergence_contract(sim))
+    nbo = read_checked(snakemake.input.nbo_error, nbo_error_contract(sim))
     summary = analysis.summarize_convergence(conv, eps)
     nbo_summary = analysis.summarize_nbo_error(nbo)
     tables = analysis.lqg_tables(summary, nbo_summary, eps)

@@ -1,23 +1,36 @@
-"""Rule uav_collect: concatenate the chunks into results/uav/runs.csv and steps.parquet."""
+"""Rule uav_collect: check every chunk, concatenate them into results/uav/runs.csv and
+steps.parquet."""
+
+from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.experiments.uav import RUN_COLUMNS, STEP_COLUMNS
-from rsmhp.io import read_table, write_csv, write_parquet
+from rsmhp.contracts import check_table, read_checked
+from rsmhp.experiments.uav import STEP_COLUMNS, chunk_contracts, chunk_runs, runs_contract
+from rsmhp.io import write_csv, write_parquet
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake.log[0], snakemake.rule) as log:
-    order = {m: i for i, m in enumerate(snakemake.params.methods)}
+    p = snakemake.params
+    order = {m: i for i, m in enumerate(p.methods)}
 
-    def collect(paths, columns, keys):
-        df = pd.concat([read_table(p, columns) for p in paths], ignore_index=True)
+    def contracts(path):
+        """The chunk's (runs, steps) contracts; the path is results/uav/chunks/<method>/<k>.*"""
+        method, chunk = Path(path).parent.name, int(Path(path).stem)
+        runs = chunk_runs(p.runs, p.chunks, chunk)
+        return chunk_contracts(p.specs[method], runs, p.steps, p.seed)
+
+    def collect(frames, keys):
+        df = pd.concat(frames, ignore_index=True)
         df = df.assign(_o=df["method"].map(order)).sort_values(["_o", *keys], kind="stable")
-        return df.drop(columns="_o").reset_index(drop=True)[columns]
+        return df.drop(columns="_o").reset_index(drop=True)
 
-    runs = collect(snakemake.input.runs, RUN_COLUMNS, ["run"])
-    steps = collect(snakemake.input.steps, STEP_COLUMNS, ["run", "step"])
-    if runs.duplicated(["method", "run"]).any():
-        raise ValueError("duplicate (method, run) rows across chunks")
-    write_csv(runs, snakemake.output.runs)
-    write_parquet(steps, snakemake.output.steps)
+    runs = collect([read_checked(f, contracts(f)[0]) for f in snakemake.input.runs], ["run"])
+    steps = collect(
+        [read_checked(f, contracts(f)[1]) for f in snakemake.input.steps], ["run", "step"]
+    )
+    contract = runs_contract(p.methods, p.runs, p.seed)
+    runs = check_table(runs, "results/uav/chunks (all chunks together)", contract)
+    write_csv(runs[list(contract.columns)], snakemake.output.runs)
+    write_parquet(steps[STEP_COLUMNS], snakemake.output.steps)
     log.info("%d runs, %d steps", len(runs), len(steps))

@@ -2,14 +2,16 @@
 
 from pathlib import Path
 
-from rsmhp.experiments.uav import RUN_COLUMNS
+from rsmhp.contracts import read_checked
+from rsmhp.experiments.uav import runs_contract
 from rsmhp.figures import save_figure
 from rsmhp.figures import uav as figs
 from rsmhp.io import read_table
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake.log[0], snakemake.rule):
-    runs = read_table(snakemake.input.runs, RUN_COLUMNS)
+    p = snakemake.params
+    runs = read_checked(snakemake.input.runs, runs_contract(p.methods, p.runs, p.seed))
     summary = read_table(snakemake.input.summary, ["method", "family", "label", "N_T", "n_runs"])
     paired = read_table(
         snakemake.input.paired, ["method", "baseline", "mean_diff", "ci_low", "ci_high"]

@@ -3,13 +3,15 @@
 from pathlib import Path
 
 from rsmhp.analysis import uav as analysis
-from rsmhp.experiments.uav import RUN_COLUMNS
-from rsmhp.io import read_table, write_csv, write_text
+from rsmhp.contracts import read_checked
+from rsmhp.experiments.uav import runs_contract
+from rsmhp.io import write_csv, write_text
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake.log[0], snakemake.rule):
     an, seed = snakemake.params.analysis, snakemake.params.seed
-    runs = read_table(snakemake.input.runs, RUN_COLUMNS)
+    contract = runs_contract(snakemake.params.methods, snakemake.params.runs, seed)
+    runs = read_checked(snakemake.input.runs, contract)
     summary = analysis.summarize_methods(runs, seed, an["bootstrap"], an["level"])
     paired = analysis.paired_differences(runs, seed, an["bootstrap"], an["level"])
     tables = analysis.uav_tables(summary, paired)

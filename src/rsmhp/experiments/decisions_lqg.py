@@ -42,6 +42,7 @@ import numpy as np
 import pandas as pd
 
 from rsmhp import lqg, samplers
+from rsmhp.contracts import Contract
 from rsmhp.estimators import likeliness_weights
 from rsmhp.parallel import parallel_map
 from rsmhp.sampling import sample_tree
@@ -221,6 +222,28 @@ LQG_REGRET_COLUMNS = [
     "regret",
     "shift",
 ]
+
+
+def regret_contract(cfg: Mapping[str, Any]) -> Contract:
+    """What ``results/decisions/lqg_regret.csv`` must hold for the ``decisions.lqg`` config
+    section: one row per (cell, weighting, replicate) of :func:`regret_cells`, one replicate
+    for the deterministic methods, finite regrets."""
+    reps = int(cfg["replicates"])
+    names = ["problem", "method", "weighting", "N", "M", "P", "replicate"]
+    keys = [
+        (c.problem, c.method, w, c.N, c.M, c.P, r)
+        for c in regret_cells(cfg)
+        for r in range(1 if c.method in DETERMINISTIC else reps)
+        for w in (("uniform", "likeliness") if c.method in WEIGHTED else ("uniform",))
+    ]
+    return Contract(
+        rule="decisions_lqg",
+        columns=LQG_REGRET_COLUMNS,
+        text=("problem", "method", "weighting"),
+        integer=("H", "N", "M", "P", "replicate"),
+        keys=names,
+        expected=pd.DataFrame(keys, columns=names),
+    )
 
 
 def run_lqg_regret(

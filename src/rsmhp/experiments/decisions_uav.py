@@ -49,6 +49,7 @@ import pandas as pd
 from scipy import stats
 from threadpoolctl import threadpool_limits
 
+from rsmhp.contracts import Contract
 from rsmhp.parallel import parallel_map
 from rsmhp.seeding import job_rng
 from rsmhp.uav import fused, target
@@ -112,6 +113,65 @@ MAP_RUN_COLUMNS = [
     "detect_rate",
     "lost",
 ]
+
+
+_REGRET_INTEGERS = ("run", "step", "N_T", "N", "M", "n_eval")
+# Spearman correlations are undefined (empty) where a method's cost is constant over the plans
+_REGRET_NULLABLE = ("spearman_random", "spearman_local")
+
+
+def _regret_contract(rule: str, models: Sequence[str], runs: int, steps, methods) -> Contract:
+    names = ["model", "run", "step", "method"]
+    keys = [
+        (m, r, k, name)
+        for m in models
+        for r in range(int(runs))
+        for k in sorted({int(s) for s in steps})
+        for name in method_specs({"methods": methods})
+    ]
+    return Contract(
+        rule=rule,
+        columns=REGRET_COLUMNS,
+        text=("model", "method", "family"),
+        integer=_REGRET_INTEGERS,
+        nullable=_REGRET_NULLABLE,
+        keys=names,
+        expected=pd.DataFrame(keys, columns=names),
+        min_rows=0,
+    )
+
+
+def regret_contract(cfg: Mapping[str, Any]) -> Contract:
+    """What ``results/decisions/uav_regret.csv`` must hold for the ``decisions.uav`` config
+    section: one row per (model, run, step, method)."""
+    models = [m["name"] for m in cfg["models"]]
+    return _regret_contract("decisions_uav", models, cfg["runs"], cfg["steps"], cfg["methods"])
+
+
+def map_contracts(cfg: Mapping[str, Any], cell: str) -> tuple[Contract, Contract]:
+    """What one map cell's runs CSV and regret CSV (rule ``decisions_map_cell``) must hold
+    for the ``decisions.map`` config section: every (method, run) and every open-loop
+    (run, step, method) of the cell. ``row_value``/``col_value`` are empty for an unlimited
+    footprint (``null``)."""
+    names = {c.name: c for c in map_cells(cfg)}
+    if cell not in names:
+        raise ValueError(f"unknown map cell {cell!r}; cells: {', '.join(names)}")
+    keys = [(m, r) for m in method_specs({"methods": cfg["methods"]}) for r in range(cfg["runs"])]
+    runs = Contract(
+        rule="decisions_map_cell",
+        columns=MAP_RUN_COLUMNS,
+        text=("cell", "method"),
+        boolean=("lost",),
+        integer=("run",),
+        nullable=("row_value", "col_value"),
+        keys=("method", "run"),
+        expected=pd.DataFrame(keys, columns=["method", "run"]),
+        values={"cell": cell},
+    )
+    regret = _regret_contract(
+        "decisions_map_cell", [cell], cfg["regret_runs"], cfg["regret_steps"], cfg["methods"]
+    )
+    return runs, regret
 
 
 def merge_variant(uav: Mapping[str, Any], variant: Mapping[str, Any]) -> dict[str, Any]:

@@ -40,6 +40,7 @@ import numpy as np
 import pandas as pd
 
 from rsmhp import samplers
+from rsmhp.contracts import Contract
 from rsmhp.estimators import uniform_estimate, weighted_estimate
 from rsmhp.linear_quadratic import LinearQuadratic
 from rsmhp.parallel import parallel_map
@@ -147,6 +148,54 @@ def grid_points(cfg: Mapping[str, Any], problems: Mapping[str, LinearQuadratic])
             else:
                 raise ValueError(f"unknown scheme {scheme!r}")
     return pts
+
+
+def _n_trajectories(point: GridPoint, prob: LinearQuadratic) -> int:
+    """Trajectories (leaves, points) behind one estimate of ``point``."""
+    s, H, D = point.scheme, prob.H, prob.H * prob.d
+    if s in ("mc", "antithetic", "sobol"):
+        return point.n
+    if s in ("tree", "tree_pernode"):
+        return point.N**H
+    if s == "pruned":
+        keep = 1
+        for _ in range(H):
+            keep = min(point.M, keep * point.N)
+        return keep
+    return {"cubature": 2 * D, "gauss_hermite": point.N**D, "nbo": 1}[s]
+
+
+def _weightings(scheme: str) -> tuple[str, ...]:
+    """The ``weighting`` values of a scheme's rows (see :func:`_rows`)."""
+    if scheme in samplers.DETERMINISTIC:
+        return ("quadrature",)
+    if scheme == "nbo":
+        return ("nominal",)
+    return ("uniform", "weighted") if scheme in WEIGHTED_SCHEMES else ("uniform",)
+
+
+def ablation_contract(cfg: Mapping[str, Any], lqg_model: Mapping[str, Any]) -> Contract:
+    """What ``results/estimators/ablation.csv`` must hold for the ``estimators`` config
+    section: one row per (grid point, weighting, replicate), one replicate for the
+    deterministic schemes, finite estimates."""
+    specs = {s["name"]: {k: v for k, v in s.items() if k != "name"} for s in cfg["problems"]}
+    problems = {name: build_problem(spec, lqg_model) for name, spec in specs.items()}
+    reps = int(cfg["replicates"])
+    keys = [
+        (p.problem, p.scheme, w, p.N, p.M, _n_trajectories(p, problems[p.problem]), r)
+        for p in grid_points(cfg, problems)
+        for w in _weightings(p.scheme)
+        for r in range(1 if p.deterministic else reps)
+    ]
+    names = ["problem", "scheme", "weighting", "N", "M", "n_trajectories", "replicate"]
+    return Contract(
+        rule="estimators_ablation",
+        columns=ABLATION_COLUMNS,
+        text=("problem", "scheme", "weighting"),
+        integer=("N", "M", "H", "n_trajectories", "n_nodes", "replicate"),
+        keys=names,
+        expected=pd.DataFrame(keys, columns=names),
+    )
 
 
 def _sample(point: GridPoint, prob: LinearQuadratic, rng: np.random.Generator | None):

@@ -6,6 +6,7 @@ its ``P x H`` noise from ``job_rng(seed, <experiment>, a=..., H=..., ..., P=P, r
 
 from __future__ import annotations
 
+import itertools
 import logging
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -15,6 +16,7 @@ import numpy as np
 import pandas as pd
 
 from rsmhp import lqg
+from rsmhp.contracts import Contract
 from rsmhp.estimators import nbo_estimate, uniform_estimate, weighted_estimate
 from rsmhp.parallel import chunked, parallel_map
 from rsmhp.sampling import sample_independent
@@ -91,6 +93,53 @@ class LQGParams:
     def closed(self) -> dict[str, float]:
         """Keyword arguments of the closed forms in :mod:`rsmhp.lqg`."""
         return {"x0": self.x0, "a": self.a, "r": self.r, "target": self.target, "sigma": self.sigma}
+
+
+def _constants(params: LQGParams) -> dict[str, float]:
+    return {k: getattr(params, k) for k in ("a", "sigma", "r", "target", "x0")}
+
+
+def convergence_contract(cfg: Mapping[str, Any]) -> Contract:
+    """What ``results/lqg/convergence.csv`` must hold for the ``lqg`` config section ``cfg``:
+    one row per (P, replicate) of the grid, the model constants of the config, finite
+    estimates."""
+    conv = cfg["convergence"]
+    keys = itertools.product(p_grid(conv["P"]), range(int(conv["replicates"])))
+    return Contract(
+        rule="lqg_convergence",
+        columns=CONVERGENCE_COLUMNS,
+        text=("u",),
+        integer=("H", "P", "replicate"),
+        keys=("P", "replicate"),
+        expected=pd.DataFrame(list(keys), columns=["P", "replicate"]),
+        values={
+            **_constants(LQGParams.from_config(cfg["model"])),
+            "H": len(conv["u"]),
+            "u": ";".join(repr(float(v)) for v in conv["u"]),
+        },
+    )
+
+
+def nbo_error_contract(cfg: Mapping[str, Any]) -> Contract:
+    """What ``results/lqg/nbo_error.csv`` must hold for the ``lqg`` config section ``cfg``:
+    one row per (a, H, replicate) of the grid (``nbo_error_se`` is empty when P = 1)."""
+    ne = cfg["nbo_error"]
+    keys = itertools.product(
+        [float(a) for a in ne["a_values"]],
+        [int(h) for h in ne["H_values"]],
+        range(int(ne["replicates"])),
+    )
+    params = _constants(LQGParams.from_config(cfg["model"]))
+    del params["a"]
+    return Contract(
+        rule="lqg_nbo_error",
+        columns=NBO_ERROR_COLUMNS,
+        integer=("H", "P", "replicate"),
+        nullable=("nbo_error_se",),
+        keys=("a", "H", "replicate"),
+        expected=pd.DataFrame(list(keys), columns=["a", "H", "replicate"]),
+        values={**params, "P": int(ne["P"]), "u_value": float(ne["u_value"])},
+    )
 
 
 def p_grid(spec: Mapping[str, int]) -> list[int]:

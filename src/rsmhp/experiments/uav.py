@@ -14,6 +14,7 @@ from typing import Any
 
 import pandas as pd
 
+from rsmhp.contracts import Contract
 from rsmhp.parallel import chunked, parallel_map
 from rsmhp.uav.simulation import MethodSpec, UAVSetup, simulate_run
 
@@ -22,8 +23,10 @@ __all__ = [
     "RUN_COLUMNS",
     "STEP_COLUMNS",
     "UAV_MODEL_KEYS",
+    "chunk_contracts",
     "chunk_runs",
     "run_chunk",
+    "runs_contract",
 ]
 
 log = logging.getLogger(__name__)
@@ -77,6 +80,56 @@ def chunk_runs(n_runs: int, n_chunks: int, chunk: int) -> list[int]:
     if not 0 <= chunk < len(parts):
         raise ValueError(f"chunk {chunk} out of range: {n_runs} runs make {len(parts)} chunks")
     return parts[chunk]
+
+
+_RUN_INTEGERS = ("N_T", "N", "M", "run", "seed")
+_STEP_INTEGERS = ("N_T", "run", "step", "nit", "kernel_calls")
+
+
+def runs_contract(methods: Sequence[str], n_runs: int, seed: int) -> Contract:
+    """What ``results/uav/runs.csv`` must hold: one row per (method, run) for runs
+    ``0..n_runs-1`` of every method, simulated with ``seed``, finite errors."""
+    keys = [(m, r) for m in methods for r in range(int(n_runs))]
+    return Contract(
+        rule="uav_collect",
+        columns=RUN_COLUMNS,
+        text=("method", "family"),
+        integer=_RUN_INTEGERS,
+        keys=("method", "run"),
+        expected=pd.DataFrame(keys, columns=["method", "run"]),
+        values={"seed": int(seed)},
+    )
+
+
+def chunk_contracts(
+    method: MethodSpec | Mapping[str, Any], runs: Sequence[int], steps: int, seed: int
+) -> tuple[Contract, Contract]:
+    """What one chunk's runs CSV and steps Parquet (rule ``uav_simulate``) must hold: the
+    runs ``runs`` of ``method``, each with steps ``1..steps``."""
+    if not isinstance(method, MethodSpec):
+        method = MethodSpec(**method)
+    runs = [int(r) for r in runs]
+    fixed = {"method": method.name, "N_T": method.n_traj}
+    run_c = Contract(
+        rule="uav_simulate",
+        columns=RUN_COLUMNS,
+        text=("method", "family"),
+        integer=_RUN_INTEGERS,
+        keys=("run",),
+        expected=pd.DataFrame({"run": runs}),
+        values={**fixed, "family": method.family, "seed": int(seed)},
+    )
+    step_keys = [(r, k) for r in runs for k in range(1, int(steps) + 1)]
+    step_c = Contract(
+        rule="uav_simulate",
+        columns=STEP_COLUMNS,
+        text=("method",),
+        integer=_STEP_INTEGERS,
+        keys=("run", "step"),
+        expected=pd.DataFrame(step_keys, columns=["run", "step"]),
+        values=fixed,
+    )
+    return run_c, step_c
 
 
 def _one_run(job: tuple[Mapping[str, Any], MethodSpec, int, int]) -> tuple[dict, list[dict]]:
