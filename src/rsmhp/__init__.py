@@ -11,6 +11,8 @@ sampling    tree / pruned-tree / non-overlapping trajectory sampling with likeli
 estimators  uniform and likeliness-weighted averages, NBO
 lqg         the scalar "oven" LQG case study and all its closed forms
 parallel    joblib fan-out that honours a thread budget without oversubscribing BLAS
+guards      argument checks of the public entry points (ValueError / TypeError naming the
+            argument, the value and what is allowed)
 """
 
 __version__ = "0.1.0"

@@ -22,16 +22,44 @@ from __future__ import annotations
 
 import numpy as np
 
-from rsmhp.sampling import System
+from rsmhp import guards
+from rsmhp.sampling import System, _controls, _initial_state
 
 __all__ = ["likeliness_weights", "nbo_estimate", "uniform_estimate", "weighted_estimate"]
 
 
+def _axis(name: str, a: np.ndarray, axis: int) -> None:
+    """``axis`` is an integer axis of ``a`` (at least 1-D) along which there is something."""
+    guards.integer("axis", axis)
+    if a.ndim == 0 or not -a.ndim <= axis < a.ndim:
+        raise ValueError(f"axis must be a valid axis of {name} (shape {a.shape}), got {axis}")
+    if a.shape[axis] == 0:
+        raise ValueError(f"cannot average zero trajectories ({name} has shape {a.shape})")
+
+
+def _log_likeliness(log_likeliness: np.ndarray, axis: int) -> np.ndarray:
+    """Log-likeliness as floats: no NaN or +inf (-inf, a zero likeliness, is allowed), not
+    -inf everywhere along ``axis``."""
+    ll = guards.float_array("log_likeliness", log_likeliness)
+    _axis("log_likeliness", ll, axis)
+    if np.isnan(ll).any() or np.isposinf(ll).any():
+        bad = ll[np.isnan(ll) | np.isposinf(ll)]
+        raise ValueError(
+            f"log_likeliness must be finite or -inf (zero likeliness), got {bad[0]} "
+            f"({bad.size} such entries)"
+        )
+    if np.isneginf(ll.max(axis=axis)).any():
+        raise ValueError(
+            "log_likeliness must not be -inf for every trajectory along the axis "
+            "(zero total likeliness: the weights are undefined)"
+        )
+    return ll
+
+
 def uniform_estimate(cost: np.ndarray, axis: int = -1) -> np.ndarray:
     r"""Sample average :math:`\frac1n\sum_i g_i` along ``axis``."""
-    cost = np.asarray(cost, dtype=float)
-    if cost.shape[axis] == 0:
-        raise ValueError("cannot average zero trajectories")
+    cost = guards.finite_array("cost", cost)
+    _axis("cost", cost, axis)
     return cost.mean(axis=axis)
 
 
@@ -41,7 +69,7 @@ def likeliness_weights(log_likeliness: np.ndarray, axis: int = -1) -> np.ndarray
     Computed from log-likeliness with the max subtracted first (no under/overflow even for
     products of hundreds of densities).
     """
-    ll = np.asarray(log_likeliness, dtype=float)
+    ll = _log_likeliness(log_likeliness, axis)
     shifted = np.exp(ll - ll.max(axis=axis, keepdims=True))
     n = ll.shape[axis]
     return n * shifted / shifted.sum(axis=axis, keepdims=True)
@@ -49,15 +77,22 @@ def likeliness_weights(log_likeliness: np.ndarray, axis: int = -1) -> np.ndarray
 
 def weighted_estimate(cost: np.ndarray, log_likeliness: np.ndarray, axis: int = -1) -> np.ndarray:
     r"""Likeliness-weighted average :math:`\frac1n\sum_i q_i g_i = \sum_i L_i g_i / \sum_i L_i`."""
-    q = likeliness_weights(log_likeliness, axis=axis)
-    return np.mean(q * np.asarray(cost, dtype=float), axis=axis)
+    cost = guards.finite_array("cost", cost)
+    ll = guards.float_array("log_likeliness", log_likeliness)
+    if cost.shape != ll.shape:
+        raise ValueError(
+            f"cost and log_likeliness must have the same shape, got {cost.shape} and {ll.shape}"
+        )
+    q = likeliness_weights(ll, axis=axis)
+    return np.mean(q * cost, axis=axis)
 
 
 def nbo_estimate(system: System, x0: np.ndarray, u: np.ndarray | list[float]) -> float:
     r"""NBO cost: the cost of the single trajectory with every noise at its mean,
     :math:`\tilde x_{k+1} = f(\tilde x_k, u_k, \bar w_k)`, :math:`J_{NBO} = \sum_k g(\tilde x_k,
     u_k) + g_H(\tilde x_H)`."""
-    u = np.asarray(u, dtype=float)
+    u = _controls(u)
+    _initial_state(system, x0)
     x = np.atleast_1d(np.asarray(x0, dtype=float))[None, :]
     w = system.noise.mean[None, :]
     total = 0.0

@@ -33,18 +33,27 @@ from functools import cached_property
 
 import numpy as np
 
+from rsmhp import guards
 from rsmhp.sampling import GaussianNoise
 
 __all__ = ["LinearQuadratic", "QuadraticForm"]
 
 
 def _mat(x, name: str, shape: tuple[int, int] | None = None) -> np.ndarray:
-    m = np.atleast_2d(np.asarray(x, dtype=float))
+    m = np.atleast_2d(guards.finite_array(name, x))
+    if m.ndim != 2:
+        raise ValueError(f"{name} must be a matrix (2-D), got shape {m.shape}")
     if shape is not None and m.shape != shape:
         raise ValueError(f"{name} must have shape {shape}, got {m.shape}")
-    if not np.all(np.isfinite(m)):
-        raise ValueError(f"{name} must be finite")
     return m
+
+
+def _vec(x, name: str, d: int) -> np.ndarray:
+    """A finite vector of ``d`` entries (any shape holding exactly ``d`` numbers)."""
+    v = guards.finite_array(name, x)
+    if v.size != d:
+        raise ValueError(f"{name} must have {d} entries (the state dimension), got shape {v.shape}")
+    return v.reshape(d)
 
 
 @dataclass(frozen=True, eq=False)
@@ -61,6 +70,14 @@ class QuadraticForm:
     sigma: np.ndarray
     H: int
 
+    def __post_init__(self) -> None:
+        guards.positive_int("H", self.H)
+        guards.real("c", self.c)
+        sigma = guards.spd_matrix("sigma", self.sigma, semi=True)
+        n = self.H * sigma.shape[0]
+        guards.finite_array("b", self.b, shape=(n,))
+        guards.finite_array("K", self.K, shape=(n, n))
+
     @property
     def d(self) -> int:
         return self.sigma.shape[0]
@@ -73,6 +90,11 @@ class QuadraticForm:
     def evaluate(self, w: np.ndarray) -> np.ndarray:
         """:math:`g(w)` for stacked noise ``w`` of shape ``(..., H d)`` (or ``(..., H, d)``)."""
         w = np.asarray(w, dtype=float)
+        n = self.H * self.d
+        if w.ndim == 0 or not (w.shape[-1] == n or w.shape[-2:] == (self.H, self.d)):
+            raise ValueError(
+                f"w must have shape (..., {n}) or (..., {self.H}, {self.d}), got {w.shape}"
+            )
         w = w.reshape(*w.shape[: w.ndim - (2 if w.shape[-2:] == (self.H, self.d) else 1)], -1)
         return self.c + w @ self.b + np.einsum("...i,ij,...j->...", w, self.K, w)
 
@@ -88,6 +110,7 @@ class QuadraticForm:
     def mean(self, scale: float = 1.0) -> float:
         r""":math:`E[g]` under :math:`w \sim \mathcal N(0, \text{scale}\cdot S)`:
         :math:`c + \text{scale}\,\mathrm{tr}(KS)`. ``scale=1`` is the exact J."""
+        guards.real("scale", scale, lo=0.0)
         return float(self.c + scale * np.trace(self.K @ self.S))
 
     def nominal(self) -> float:
@@ -121,6 +144,18 @@ class QuadraticForm:
         """
         if len(draws) != self.H:
             raise ValueError(f"need draws for {self.H} levels, got {len(draws)}")
+        if weights is not None and len(weights) != self.H:
+            raise ValueError(f"need weights for {self.H} levels, got {len(weights)}")
+        for k, wk in enumerate(draws):
+            wk = guards.finite_array(f"draws[{k}]", wk, ndim=(1, 2), nonempty=True)
+            if wk.size != len(wk) * self.d:
+                raise ValueError(f"draws[{k}] must have shape (N_k, {self.d}), got {wk.shape}")
+            if weights is not None:
+                om = guards.finite_array(f"weights[{k}]", weights[k], shape=(len(wk),))
+                if np.any(om < 0) or not om.sum() > 0:
+                    raise ValueError(
+                        f"weights[{k}] must be >= 0 with a positive sum, got {guards.show(om)}"
+                    )
         means, extra = [], 0.0
         for k, wk in enumerate(draws):
             wk = np.asarray(wk, dtype=float).reshape(len(wk), self.d)
@@ -139,11 +174,13 @@ class QuadraticForm:
     # --- estimator variances ------------------------------------------------------------
     def independent_variance(self, n: int) -> float:
         """Uniform average of ``n`` independent trajectories: ``Var(g)/n``."""
+        guards.positive_int("n", n)
         return self.variance() / n
 
     def antithetic_variance(self, n: int) -> float:
         r"""``n/2`` antithetic pairs :math:`(w, -w)`: the pair mean :math:`c + w^\top K w` cancels
         the linear term, so the variance is :math:`2\,\mathrm{tr}((KS)^2)/(n/2)`."""
+        guards.positive_int("n", n)
         if n % 2:
             raise ValueError(f"antithetic sampling needs an even number of trajectories, got {n}")
         KS = self.K @ self.S
@@ -165,8 +202,7 @@ class QuadraticForm:
         It decays like 1/N, not like :math:`1/N^H` as for :math:`N^H` independent
         trajectories: the leaves share their draws.
         """
-        if N < 2:
-            raise ValueError("the tree variance formula needs N >= 2")
+        guards.integer("N", N, minimum=2)  # the formula needs N >= 2
         KS = self.K @ self.S
         diag = sum(
             float(np.trace((self._block(k, k) @ self.sigma) @ (self._block(k, k) @ self.sigma)))
@@ -182,6 +218,7 @@ class QuadraticForm:
         r"""Covariance of the costs of two trajectories that share exactly their first ``m``
         draws: :math:`\mathrm{Var}(E[g\mid w_{<m}]) = b_A^\top S_A b_A + 2\,\mathrm{tr}((K_{AA}
         S_A)^2)` with ``A`` the first ``m`` blocks."""
+        guards.integer("m", m, minimum=0, maximum=self.H)
         if m == 0:
             return 0.0
         n = m * self.d
@@ -196,6 +233,7 @@ class QuadraticForm:
         :math:`\mathrm{Var} = N^{-H}\,[\mathrm{Var}(g) + \sum_{m=1}^{H-1}(N^{H-m}-N^{H-m-1})
         C_m]`.
         """
+        guards.positive_int("N", N)
         H = self.H
         total = self.variance() + sum(
             (N ** (H - m) - N ** (H - m - 1)) * self.prefix_covariance(m) for m in range(1, H)
@@ -233,7 +271,7 @@ class LinearQuadratic:
         if B.shape[0] != d:
             raise ValueError(f"B must have {d} rows, got {B.shape}")
         m = B.shape[1]
-        u = np.asarray(self.u, dtype=float)
+        u = guards.finite_array("u", self.u)
         u = u.reshape(-1, m) if u.ndim <= 1 else u
         if u.ndim != 2 or u.shape[1] != m or u.shape[0] < 1:
             raise ValueError(f"u must have shape (H, {m}) with H >= 1, got {np.shape(self.u)}")
@@ -244,14 +282,20 @@ class LinearQuadratic:
             "Q": _mat(self.Q, "Q", (d, d)),
             "R": _mat(self.R, "R", (m, m)),
             "Qf": _mat(self.Qf, "Qf", (d, d)),
-            "target": np.asarray(self.target, dtype=float).reshape(d),
-            "x0": np.asarray(self.x0, dtype=float).reshape(d),
+            "target": _vec(self.target, "target", d),
+            "x0": _vec(self.x0, "x0", d),
             "u": u,
         }
+        guards.spd_matrix("Sigma", fields["Sigma"], semi=True)
         for key in ("Q", "R", "Qf"):
             M = fields[key]
-            if not np.allclose(M, M.T) or np.linalg.eigvalsh(M).min() < -1e-12:
-                raise ValueError(f"{key} must be symmetric positive semi-definite")
+            if not np.allclose(M, M.T):
+                raise ValueError(f"{key} must be symmetric positive semi-definite, got {M}")
+            if (low := np.linalg.eigvalsh(M).min()) < -1e-12:
+                raise ValueError(
+                    f"{key} must be symmetric positive semi-definite, got smallest eigenvalue "
+                    f"{low:.6g}"
+                )
         for key, val in fields.items():
             object.__setattr__(self, key, val)
 
@@ -260,10 +304,11 @@ class LinearQuadratic:
         cls, u, *, x0: float, a: float, r: float, target: float, sigma: float
     ) -> LinearQuadratic:
         """The paper's oven problem (:mod:`rsmhp.lqg`) in this general form."""
-        if not 0 < a < 1:
-            raise ValueError(f"a must lie in the open interval (0, 1), got {a}")
-        if not sigma > 0:
-            raise ValueError(f"sigma must be > 0, got {sigma}")
+        guards.real("a", a, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
+        guards.real("r", r, lo=0.0)
+        guards.real("sigma", sigma, lo=0.0, lo_open=True)
+        guards.real("x0", x0)
+        guards.real("target", target)
         return cls(
             A=[[1 - a]],
             B=[[a]],

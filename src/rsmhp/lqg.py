@@ -55,6 +55,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from rsmhp import guards
 from rsmhp.sampling import GaussianNoise
 
 __all__ = [
@@ -76,25 +77,37 @@ __all__ = [
 ]
 
 
-def _check(a: float | None = None, sigma: float | None = None, r: float | None = None) -> None:
-    if a is not None and not 0.0 < a < 1.0:
-        raise ValueError(f"a must lie in the open interval (0, 1), got {a}")
-    if sigma is not None and not sigma >= 0.0:
-        raise ValueError(f"sigma must be >= 0, got {sigma}")
-    if r is not None and not r >= 0.0:
-        raise ValueError(f"r must be >= 0, got {r}")
+def _check(
+    a: float | None = None,
+    sigma: float | None = None,
+    r: float | None = None,
+    **finite: float | None,
+) -> None:
+    """Model parameters: ``a`` in (0, 1), ``sigma`` >= 0, ``r`` >= 0, and the named values
+    ``finite`` (``x0``, ``target``) finite numbers; ``None`` skips a check."""
+    if a is not None:
+        guards.real("a", a, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
+    if sigma is not None:
+        guards.real("sigma", sigma, lo=0.0)
+    if r is not None:
+        guards.real("r", r, lo=0.0)
+    for name, value in finite.items():
+        if value is not None:
+            guards.real(name, value)
 
 
 def _u(u: np.ndarray | list[float]) -> np.ndarray:
-    u = np.atleast_1d(np.asarray(u, dtype=float))
+    u = np.atleast_1d(guards.finite_array("u", u))
     if u.ndim != 1 or u.size == 0:
-        raise ValueError("u must be a non-empty 1-D control sequence (length H)")
+        raise ValueError(
+            f"u must be a non-empty 1-D control sequence (length H), got shape {u.shape}"
+        )
     return u
 
 
 def state_mean(u: np.ndarray | list[float], *, x0: float, a: float) -> float:
     r""":math:`E[x_H] = (1-a)^H x_0 + a\sum_{k=0}^{H-1}(1-a)^{H-1-k}u_k` (H = len(u))."""
-    _check(a=a)
+    _check(a=a, x0=x0)
     u = _u(u)
     horizon = u.size
     b = 1.0 - a
@@ -104,15 +117,14 @@ def state_mean(u: np.ndarray | list[float], *, x0: float, a: float) -> float:
 
 def state_variance(H: int, *, a: float, sigma: float) -> float:
     r""":math:`\mathrm{Var}[x_H] = \sigma^2 \sum_{n=0}^{H-1} (1-a)^{2n}`."""
+    H = guards.positive_int("H", H)
     _check(a=a, sigma=sigma)
-    if H < 1:
-        raise ValueError(f"H must be >= 1, got {H}")
     return float(sigma**2 * np.sum((1.0 - a) ** (2 * np.arange(H))))
 
 
 def nbo_cost(u: np.ndarray | list[float], *, x0: float, a: float, r: float, target: float) -> float:
     r""":math:`J_{NBO} = r(m_H - T)^2 + \sum_k u_k^2` (all noise at its mean 0)."""
-    _check(a=a, r=r)
+    _check(a=a, r=r, x0=x0, target=target)
     u = _u(u)
     return float(r * (state_mean(u, x0=x0, a=a) - target) ** 2 + np.dot(u, u))
 
@@ -135,6 +147,7 @@ def cost_variance(
     u: np.ndarray | list[float], *, x0: float, a: float, r: float, target: float, sigma: float
 ) -> float:
     r"""Variance of one trajectory's cost, :math:`r^2(2v_H^2 + 4\mu^2 v_H)`, :math:`\mu=m_H-T`."""
+    _check(r=r, target=target)
     u = _u(u)
     mu = state_mean(u, x0=x0, a=a) - target
     v = state_variance(u.size, a=a, sigma=sigma)
@@ -153,9 +166,8 @@ def mhp_variance(
 ) -> float | np.ndarray:
     r"""Variance of the uniform estimator from ``P`` non-overlapping trajectories:
     :math:`\mathrm{Var}(g)/P`."""
+    guards.int_array("P", P, minimum=1)
     P = np.asarray(P)
-    if np.any(P < 1):
-        raise ValueError("P must be >= 1")
     out = cost_variance(u, x0=x0, a=a, r=r, target=target, sigma=sigma) / P
     return float(out) if out.ndim == 0 else out
 
@@ -173,9 +185,9 @@ def chebyshev_bound(
 ) -> float | np.ndarray:
     r"""Prop. 3: :math:`\min\{1, \mathrm{Var}(g)/(P\epsilon^2)\}` bounds
     :math:`P(|J_P - J| \ge \epsilon)`."""
-    eps = np.asarray(eps, dtype=float)
+    eps = guards.finite_array("eps", eps)
     if np.any(eps <= 0):
-        raise ValueError("eps must be > 0")
+        raise ValueError(f"eps must be > 0, got {guards.show(eps)}")
     var = mhp_variance(P, u, x0=x0, a=a, r=r, target=target, sigma=sigma)
     out = np.minimum(1.0, np.asarray(var) / eps**2)
     return float(out) if out.ndim == 0 else out
@@ -186,13 +198,13 @@ def weighted_limit(
 ) -> float:
     r"""Limit (P -> inf) of the likeliness-weighted non-overlapping estimator: :math:`J` at
     noise variance :math:`\sigma^2/2`, i.e. :math:`J - r v_H/2`."""
+    _check(sigma=sigma)
     return exact_cost(u, x0=x0, a=a, r=r, target=target, sigma=sigma / np.sqrt(2.0))
 
 
 def _coefficients(H: int, a: float) -> np.ndarray:
     """:math:`c_k = (1-a)^{H-1-k}`, k = 0..H-1: weight of :math:`a u_k + w_k` in :math:`x_H`."""
-    if isinstance(H, bool) or not isinstance(H, int | np.integer) or H < 1:
-        raise ValueError(f"H must be an integer >= 1, got {H!r}")
+    H = guards.positive_int("H", H)
     _check(a=a)
     return (1.0 - a) ** np.arange(H - 1, -1, -1, dtype=float)
 
@@ -201,7 +213,8 @@ def optimal_controls(H: int, *, x0: float, a: float, r: float, target: float) ->
     r"""Exact open-loop optimum :math:`u^* = \arg\min_u J(u)`, shape (H,):
     :math:`u^* = r a (T - b^H x_0)\, c / (1 + r a^2 |c|^2)`. NBO's cost has the same
     minimiser (it differs from J by the constant :math:`r v_H`)."""
-    _check(a=a, r=r)
+    _check(a=a, r=r, x0=x0, target=target)
+    H = guards.positive_int("H", H)
     c = _coefficients(H, a)
     return r * a * (target - (1.0 - a) ** H * x0) * c / (1.0 + r * a * a * np.dot(c, c))
 
@@ -220,7 +233,7 @@ def sample_argmin(
     summing to n all fit). With :math:`\bar e = \sum_i \omega_i c^\top w^i / \sum_i
     \omega_i` the normal equations are :math:`(I + r a^2 c c^\top)\, u = r a (T - b^H x_0 -
     \bar e)\, c`, solved directly. NBO is the single draw :math:`w = 0`."""
-    _check(a=a, r=r)
+    _check(a=a, r=r, x0=x0, target=target)
     w = np.asarray(noise, dtype=float)
     if w.ndim == 3 and w.shape[2] == 1:
         w = w[:, :, 0]
@@ -264,9 +277,8 @@ def expected_regret(n_eff: int | np.ndarray, H: int, *, a: float, r: float, sigm
     averages ``n_eff`` independent final-state noises with equal weights: n = P for P i.i.d.
     trajectories, n = N for the shared-draw tree with N draws per level. The regret is this
     mean times a :math:`\chi^2_1` variable."""
+    guards.int_array("n_eff", n_eff, minimum=1)
     n = np.asarray(n_eff)
-    if np.any(n < 1):
-        raise ValueError(f"n_eff must be >= 1, got {n_eff!r}")
     out = regret_gain(H, a=a, r=r) * state_variance(H, a=a, sigma=sigma) / n
     return float(out) if np.ndim(out) == 0 else out
 
@@ -281,7 +293,7 @@ class LQGModel:
     sigma: float
 
     def __post_init__(self) -> None:
-        _check(a=self.a, sigma=self.sigma, r=self.r)
+        _check(a=self.a, sigma=self.sigma, r=self.r, target=self.target)
         if self.sigma == 0:
             raise ValueError("sigma must be > 0 for sampling (the noise density is undefined)")
 

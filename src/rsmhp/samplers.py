@@ -25,6 +25,8 @@ from numpy.polynomial.hermite_e import hermegauss
 from scipy import special
 from scipy.stats import qmc
 
+from rsmhp import guards
+
 __all__ = [
     "DETERMINISTIC",
     "STOCHASTIC",
@@ -49,16 +51,33 @@ def _shape(z: np.ndarray, H: int, chol: np.ndarray) -> np.ndarray:
     return z.reshape(z.shape[0], H, d) @ chol.T
 
 
+def _check(H: int, chol: np.ndarray) -> tuple[int, np.ndarray]:
+    """The arguments every sampler shares: horizon ``H`` >= 1 and a finite square ``chol``
+    (d, d), d >= 1 (a square root of the noise covariance). Returns ``(H, chol)`` (a float
+    ndarray ``chol`` is returned as is)."""
+    H = guards.positive_int("H", H)
+    c = guards.finite_array("chol", chol, shape=("d", "d"), nonempty=True)
+    if c.shape[0] != c.shape[1]:
+        raise ValueError(f"chol must be a square (d, d) matrix, got shape {c.shape}")
+    return H, c
+
+
 def monte_carlo(rng: np.random.Generator, n: int, H: int, chol: np.ndarray):
     """``n`` i.i.d. sequences, uniform weights."""
+    n = guards.positive_int("n", n)
+    H, chol = _check(H, chol)
+    guards.generator("rng", rng)
     z = rng.standard_normal((n, H * chol.shape[0]))
     return _shape(z, H, chol), np.full(n, 1.0 / n)
 
 
 def antithetic(rng: np.random.Generator, n: int, H: int, chol: np.ndarray):
     """``n/2`` i.i.d. sequences followed by their negatives, uniform weights (``n`` even)."""
-    if n < 2 or n % 2:
+    n = guards.integer("n", n, minimum=2)
+    if n % 2:
         raise ValueError(f"antithetic sampling needs an even n >= 2, got {n}")
+    H, chol = _check(H, chol)
+    guards.generator("rng", rng)
     z = rng.standard_normal((n // 2, H * chol.shape[0]))
     return _shape(np.concatenate([z, -z]), H, chol), np.full(n, 1.0 / n)
 
@@ -66,9 +85,12 @@ def antithetic(rng: np.random.Generator, n: int, H: int, chol: np.ndarray):
 def sobol(rng: np.random.Generator, n: int, H: int, chol: np.ndarray):
     """The first ``n`` points of a scrambled Sobol' sequence (``n`` a power of 2 keeps its
     balance properties), mapped to normals by :math:`\\Phi^{-1}`; uniform weights."""
-    D = H * chol.shape[0]
-    if n < 1 or n & (n - 1):
+    n = guards.positive_int("n", n)
+    if n & (n - 1):
         raise ValueError(f"Sobol' sampling needs n a power of 2, got {n}")
+    H, chol = _check(H, chol)
+    guards.generator("rng", rng)
+    D = H * chol.shape[0]
     engine = qmc.Sobol(d=D, scramble=True, rng=rng)
     u = engine.random(n)
     # scrambled points never hit 0 or 1 exactly, but guard the quantile anyway
@@ -78,6 +100,7 @@ def sobol(rng: np.random.Generator, n: int, H: int, chol: np.ndarray):
 
 def cubature(H: int, chol: np.ndarray):
     """The ``2D`` points :math:`\\pm\\sqrt{D} e_j`, weights ``1/(2D)`` (deterministic)."""
+    H, chol = _check(H, chol)
     D = H * chol.shape[0]
     eye = np.sqrt(D) * np.eye(D)
     return _shape(np.concatenate([eye, -eye]), H, chol), np.full(2 * D, 1.0 / (2 * D))
@@ -85,6 +108,8 @@ def cubature(H: int, chol: np.ndarray):
 
 def gauss_hermite_order(n: int, D: int) -> int:
     """Largest nodes-per-dimension ``q`` with ``q**D <= n`` (0 if even q = 2 does not fit)."""
+    n = guards.positive_int("n", n)
+    D = guards.positive_int("D", D)
     q = int(np.floor(n ** (1.0 / D) + 1e-9))
     while q**D > n:
         q -= 1
@@ -93,9 +118,9 @@ def gauss_hermite_order(n: int, D: int) -> int:
 
 def gauss_hermite(q: int, H: int, chol: np.ndarray):
     """Tensor Gauss-Hermite rule, ``q`` nodes per dimension, ``q**D`` points (deterministic)."""
+    q = guards.positive_int("q (Gauss-Hermite nodes per dimension)", q)
+    H, chol = _check(H, chol)
     D = H * chol.shape[0]
-    if q < 1:
-        raise ValueError(f"Gauss-Hermite needs q >= 1 nodes per dimension, got {q}")
     x, w = hermegauss(q)
     w = w / np.sqrt(2 * np.pi)
     grids = np.meshgrid(*([x] * D), indexing="ij")

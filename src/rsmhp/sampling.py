@@ -29,6 +29,8 @@ from typing import Protocol
 
 import numpy as np
 
+from rsmhp import guards
+
 __all__ = [
     "GaussianNoise",
     "System",
@@ -54,14 +56,25 @@ class GaussianNoise:
     """
 
     def __init__(self, cov: float | np.ndarray) -> None:
-        cov = np.atleast_2d(np.asarray(cov, dtype=float))
-        if cov.shape[0] != cov.shape[1]:
-            raise ValueError(f"noise covariance must be square, got shape {cov.shape}")
+        cov = np.atleast_2d(guards.finite_array("noise covariance cov", cov))
+        if cov.ndim != 2 or cov.shape[0] != cov.shape[1] or cov.shape[0] == 0:
+            raise ValueError(
+                f"noise covariance cov must be a non-empty square matrix, got shape {cov.shape}"
+            )
         if not (np.array_equal(cov, cov.T) or np.allclose(cov, cov.T)):
-            raise ValueError("noise covariance must be symmetric")
+            raise ValueError(
+                f"noise covariance cov must be symmetric, got max |cov - cov^T| = "
+                f"{np.abs(cov - cov.T).max():.3g}"
+            )
         self.cov = cov
         self.dim = cov.shape[0]
-        self._chol = np.linalg.cholesky(cov)  # raises LinAlgError if not positive definite
+        try:
+            self._chol = np.linalg.cholesky(cov)
+        except np.linalg.LinAlgError:
+            low = np.linalg.eigvalsh(0.5 * (cov + cov.T))[0]
+            raise guards.NotPositiveDefiniteError(
+                f"noise covariance cov must be positive definite, got smallest eigenvalue {low:.6g}"
+            ) from None
         self._log_norm = -0.5 * (self.dim * np.log(2 * np.pi)) - np.sum(np.log(np.diag(self._chol)))
 
     @property
@@ -171,10 +184,22 @@ class TreeSample:
 
 
 def _controls(u: np.ndarray | list[float]) -> np.ndarray:
-    u = np.asarray(u, dtype=float)
+    u = guards.finite_array("u", u)
     if u.ndim == 0 or u.shape[0] == 0:
-        raise ValueError("control sequence u must have at least one step (length H >= 1)")
+        raise ValueError(
+            f"control sequence u must have at least one step (length H >= 1), got shape {u.shape}"
+        )
+    if u.ndim > 2:
+        raise ValueError(f"control sequence u must have shape (H,) or (H, m), got {u.shape}")
     return u
+
+
+def _initial_state(system: System, x0: np.ndarray) -> None:
+    """``x0``: a finite scalar or 1-D state (of the system's dimension ``d`` when it has one)."""
+    x = guards.finite_array("x0", x0, ndim=(0, 1), nonempty=True)
+    d = getattr(system, "d", None)
+    if isinstance(d, int) and x.size != d:
+        raise ValueError(f"x0 must have {d} entries (the state dimension), got shape {x.shape}")
 
 
 def top_m(log_likeliness: np.ndarray, m: int) -> np.ndarray:
@@ -182,8 +207,7 @@ def top_m(log_likeliness: np.ndarray, m: int) -> np.ndarray:
 
     Returns all indices (in that order) when ``m >= len(log_likeliness)``.
     """
-    if m < 1:
-        raise ValueError(f"M must be >= 1, got {m}")
+    m = guards.positive_int("M", m)
     order = np.argsort(-np.asarray(log_likeliness), kind="stable")
     return order[:m]
 
@@ -219,6 +243,7 @@ def rollout(
     Every sampler (plain Monte Carlo, antithetic, quasi-Monte Carlo, quadrature nodes) produces
     noise sequences and calls this; the trajectory costs it returns are then averaged.
     """
+    _initial_state(system, x0)
     noise = np.asarray(noise, dtype=float)
     states, cost = _propagate(system, x0, _controls(u), noise)
     loglik = system.noise.logpdf(noise).sum(axis=1)
@@ -230,6 +255,7 @@ def rollout_cost(
 ) -> np.ndarray:
     """Only the costs (n,) of :func:`rollout` (same arithmetic), without the likeliness, for
     estimators that do not weight by it."""
+    _initial_state(system, x0)
     return _propagate(system, x0, _controls(u), np.asarray(noise, dtype=float))[1]
 
 
@@ -241,8 +267,9 @@ def sample_independent(
     Noise is drawn as one ``(n, H, dw)`` block from ``rng`` and propagated by :func:`rollout`.
     """
     u = _controls(u)
-    if n < 1:
-        raise ValueError(f"number of trajectories must be >= 1, got {n}")
+    n = guards.positive_int("n (number of trajectories)", n)
+    guards.generator("rng", rng)
+    _initial_state(system, x0)
     return rollout(system, x0, u, system.noise.sample(rng, (n, u.shape[0])))
 
 
@@ -274,10 +301,11 @@ def sample_tree(
         paths in the result then need a common dimension.
     """
     u = _controls(u)
-    if n_branch < 1:
-        raise ValueError(f"N (draws per step) must be >= 1, got {n_branch}")
-    if max_keep is not None and max_keep < 1:
-        raise ValueError(f"M (trajectories kept) must be >= 1, got {max_keep}")
+    n_branch = guards.positive_int("N (draws per step)", n_branch)
+    if max_keep is not None:
+        max_keep = guards.positive_int("M (trajectories kept)", max_keep)
+    guards.generator("rng", rng)
+    _initial_state(system, x0)
     horizon = u.shape[0]
     if max_keep is None and n_branch**horizon > 20_000_000:
         raise ValueError(
@@ -289,6 +317,8 @@ def sample_tree(
         raise ValueError(
             f"level_noise needs one noise model per level ({u.shape[0]}), got {len(levels)}"
         )
+    for k, level in enumerate(levels):
+        guards.instance_of(f"level_noise[{k}]", level, GaussianNoise)
     noise = levels[0]
     x = np.atleast_1d(np.asarray(x0, dtype=float))[None, :]
     paths = x[:, None, :]  # (n, k+1, dx)
@@ -350,13 +380,15 @@ def sample_tree_batch(
     :func:`sample_tree`.
     """
     u = _controls(u)
-    if n_branch < 1:
-        raise ValueError(f"N (draws per step) must be >= 1, got {n_branch}")
-    if max_keep is not None and max_keep < 1:
-        raise ValueError(f"M (trajectories kept) must be >= 1, got {max_keep}")
+    n_branch = guards.positive_int("N (draws per step)", n_branch)
+    if max_keep is not None:
+        max_keep = guards.positive_int("M (trajectories kept)", max_keep)
     rngs = list(rngs)
     if not rngs:
         raise ValueError("need at least one generator (one tree per generator)")
+    for r, g in enumerate(rngs):
+        guards.generator(f"rngs[{r}]", g)
+    _initial_state(system, x0)
     horizon, noise = u.shape[0], system.noise
     n_trees, dw = len(rngs), noise.dim
     x0 = np.atleast_1d(np.asarray(x0, dtype=float))

@@ -13,15 +13,22 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from rsmhp import guards
+
 __all__ = ["SlopeFit", "binomial_ci", "loglog_slope", "mean_ci", "rmse_ci"]
+
+
+def _level(level: float) -> None:
+    guards.real("level", level, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
 
 
 def mean_ci(x: np.ndarray, level: float = 0.95) -> tuple[float, float, float]:
     r"""(mean, low, high): :math:`\bar x \pm t_{n-1,(1+level)/2}\, s/\sqrt n`."""
-    x = np.asarray(x, dtype=float)
+    _level(level)
+    x = guards.finite_array("x", x)
     n = x.size
     if n < 2:
-        raise ValueError("need at least 2 values for a confidence interval")
+        raise ValueError(f"need at least 2 values x for a confidence interval, got {n}")
     m = float(x.mean())
     half = float(stats.t.ppf(0.5 + level / 2, n - 1) * x.std(ddof=1) / np.sqrt(n))
     return m, m - half, m + half
@@ -29,8 +36,9 @@ def mean_ci(x: np.ndarray, level: float = 0.95) -> tuple[float, float, float]:
 
 def binomial_ci(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
     """Clopper-Pearson interval for a proportion ``k/n``."""
-    if n < 1 or not 0 <= k <= n:
-        raise ValueError(f"need 0 <= k <= n and n >= 1, got k={k}, n={n}")
+    n = guards.positive_int("n", n)
+    k = guards.integer("k", k, minimum=0, maximum=n)
+    _level(level)
     ci = stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="exact")
     return float(ci.low), float(ci.high)
 
@@ -38,8 +46,11 @@ def binomial_ci(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
 def rmse_ci(err: np.ndarray, level: float = 0.95) -> tuple[float, float, float]:
     r"""(rmse, low, high) of errors ``err`` about 0: :math:`n\,\mathrm{MSE}/\sigma^2 \sim \chi^2_n`
     when the errors are i.i.d. :math:`N(0,\sigma^2)`; exact for unbiased Gaussian errors."""
-    err = np.asarray(err, dtype=float)
+    _level(level)
+    err = guards.finite_array("err", err)
     n = err.size
+    if n < 1:
+        raise ValueError("need at least 1 error value err for an RMSE, got 0")
     ss = float(np.sum(err**2))
     lo = np.sqrt(ss / stats.chi2.ppf(0.5 + level / 2, n))
     hi = np.sqrt(ss / stats.chi2.ppf(0.5 - level / 2, n))
@@ -59,7 +70,10 @@ class SlopeFit:
 
 def loglog_slope(x: np.ndarray, y: np.ndarray, level: float = 0.95) -> SlopeFit:
     r"""Fit :math:`\log y = c + s \log x` by OLS; CI :math:`s \pm t_{n-2}\,\mathrm{se}(s)`."""
-    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+    _level(level)
+    x, y = guards.finite_array("x", x, ndim=1), guards.finite_array("y", y, ndim=1)
+    if x.shape != y.shape:
+        raise ValueError(f"x and y must have the same length, got {x.size} and {y.size}")
     if x.size < 3 or np.any(x <= 0) or np.any(y <= 0):
         raise ValueError("need >= 3 strictly positive points for a log-log fit")
     res = stats.linregress(np.log(x), np.log(y))

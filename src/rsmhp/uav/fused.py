@@ -61,11 +61,15 @@ from __future__ import annotations
 import numpy as np
 from numba import njit
 
+from rsmhp import guards
+from rsmhp.uav import kernel
 from rsmhp.uav.kinematics import UAVParams
 from rsmhp.uav.sensor import SensorModel
 
 __all__ = [
     "Frozen",
+    "check_frozen",
+    "check_uav_state",
     "cost",
     "cost_and_grad",
     "covariance_traces",
@@ -499,7 +503,9 @@ def covariance_traces(
     sensor: SensorModel,
 ) -> np.ndarray:
     """Compiled twin of :func:`rsmhp.uav.kernel.covariance_traces`: ``tr P_j`` (C, T, H) for
-    UAV positions ``uav_xy`` (C, H, 2) and hypotheses ``target_xy`` (T, H, 2)."""
+    UAV positions ``uav_xy`` (C, H, 2) and hypotheses ``target_xy`` (T, H, 2); arguments
+    checked by :func:`rsmhp.uav.kernel.check_arguments`."""
+    kernel.check_arguments(P0, uav_xy, target_xy, dt, Q, sensor)
     uav_xy = np.ascontiguousarray(uav_xy, dtype=float)
     target_xy = np.ascontiguousarray(target_xy, dtype=float)
     out = np.empty((uav_xy.shape[0], target_xy.shape[0], uav_xy.shape[1]))
@@ -510,13 +516,53 @@ def covariance_traces(
     )
 
 
+def check_frozen(
+    uav_state: np.ndarray,
+    uav: UAVParams,
+    P0: np.ndarray,
+    target_xy: np.ndarray,
+    target_dt: float,
+    Q: np.ndarray,
+    sensor: SensorModel,
+) -> None:
+    """The checks of :class:`Frozen`: ``uav_state`` finite (4,) with speed ``uav_state[2]``
+    > 0 (the turn rate divides by it); ``uav`` a :class:`UAVParams`; ``P0``, ``Q`` finite
+    symmetric positive semidefinite (4, 4); ``target_xy`` finite (T, H, 2), T, H >= 1;
+    ``target_dt`` > 0; ``sensor`` a :class:`SensorModel`."""
+    check_uav_state(uav_state)
+    guards.instance_of("uav", uav, UAVParams)
+    guards.spd_matrix("P0", P0, semi=True, size=4)
+    guards.finite_array("target_xy", target_xy, shape=("T", "H", 2), nonempty=True)
+    guards.real("target_dt", target_dt, lo=0.0, lo_open=True)
+    guards.spd_matrix("Q", Q, semi=True, size=4)
+    guards.instance_of("sensor", sensor, SensorModel)
+
+
+def check_uav_state(uav_state: np.ndarray) -> None:
+    """A UAV state ``(p_x, p_y, s, psi)``: finite (4,), speed ``s`` > 0 (the turn rate
+    divides by it)."""
+    state = guards.finite_array("uav_state", uav_state, shape=(4,))
+    if not state[2] > 0:
+        raise ValueError(
+            f"uav_state[2] (speed) must be > 0 (the turn rate divides by it), got {state[2]}"
+        )
+
+
 class Frozen:
     """The arguments that stay fixed during one planning step (UAV state, aircraft, posterior,
-    hypotheses, target model, sensor), converted once for :func:`evaluate`."""
+    hypotheses, target model, sensor), converted once for :func:`evaluate`.
+
+    Checked by :func:`check_frozen` unless ``check=False`` (for callers that checked them,
+    e.g. :class:`rsmhp.uav.planner.PlanningProblem`; :func:`evaluate`, called for every
+    objective evaluation, checks only the shape of ``x``)."""
 
     __slots__ = ("args",)
 
-    def __init__(self, uav_state, uav, P0, target_xy, target_dt, Q, sensor) -> None:
+    def __init__(
+        self, uav_state, uav, P0, target_xy, target_dt, Q, sensor, *, check: bool = True
+    ) -> None:
+        if check:
+            check_frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor)
         self.args = (
             np.ascontiguousarray(uav_state, dtype=float),
             np.array([uav.accel_max, uav.bank_max]),
@@ -551,7 +597,12 @@ def evaluate(x: np.ndarray, frozen: Frozen, want_grad: bool) -> tuple[np.ndarray
 def path(x: np.ndarray, frozen: Frozen) -> np.ndarray:
     """UAV states (H, 4) after each control of the normalised sequence ``x`` (2H,): the
     compiled twin of :func:`rsmhp.uav.kinematics.rollout` (same operation order)."""
+    guards.instance_of("frozen", frozen, Frozen)
     x = np.ascontiguousarray(x, dtype=float).ravel()
+    if x.size != 2 * frozen.args[7].shape[1]:
+        raise ValueError(
+            f"x must have 2H = {2 * frozen.args[7].shape[1]} entries, got shape {np.shape(x)}"
+        )
     st, sc, udt, g, smin, smax = frozen.args[:6]
     return _path_kernel(x, st, sc, udt, g, smin, smax, np.empty((x.size // 2, 4)))
 
@@ -570,7 +621,7 @@ def cost_and_grad(
     control sequences ``x`` (C, 2H) from UAV state ``uav_state`` (4,), posterior ``P0`` (4, 4)
     and hypotheses ``target_xy`` (T, H, 2) (m², per unit of normalised control)."""
     frozen = Frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor)
-    return evaluate(np.atleast_2d(x), frozen, True)
+    return evaluate(_controls(x, frozen), frozen, True)
 
 
 def cost(
@@ -585,7 +636,16 @@ def cost(
 ) -> np.ndarray:
     """Planner cost only (C,) (see :func:`cost_and_grad`)."""
     frozen = Frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor)
-    return evaluate(np.atleast_2d(x), frozen, False)[0]
+    return evaluate(_controls(x, frozen), frozen, False)[0]
+
+
+def _controls(x: np.ndarray, frozen: Frozen) -> np.ndarray:
+    """Normalised controls ``x`` (2H,) or (C, 2H), finite, as (C, 2H)."""
+    n = 2 * frozen.args[7].shape[1]
+    x = np.atleast_2d(guards.finite_array("x", x, ndim=(1, 2)))
+    if x.shape[1] != n or x.shape[0] == 0:
+        raise ValueError(f"x must have shape (C, 2H) = (C, {n}) with C >= 1, got {x.shape}")
+    return x
 
 
 def warm_up() -> float:

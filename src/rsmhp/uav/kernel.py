@@ -35,9 +35,34 @@ from __future__ import annotations
 
 import numpy as np
 
+from rsmhp import guards
 from rsmhp.uav.sensor import SensorModel, detection_probability, measurement_cov_entries
 
-__all__ = ["covariance_traces", "objective"]
+__all__ = ["check_arguments", "covariance_traces", "objective"]
+
+
+def check_arguments(
+    P0: np.ndarray,
+    uav_xy: np.ndarray,
+    target_xy: np.ndarray,
+    dt: float,
+    Q: np.ndarray,
+    sensor: SensorModel,
+) -> None:
+    """The checks of :func:`covariance_traces` (and of its compiled twin
+    :func:`rsmhp.uav.fused.covariance_traces`): ``P0`` and ``Q`` finite symmetric positive
+    semidefinite (4, 4); ``uav_xy`` (C, H, 2) and ``target_xy`` (T, H, 2) finite with
+    C, T, H >= 1 and the same H; ``dt`` > 0; ``sensor`` a :class:`SensorModel`."""
+    guards.spd_matrix("P0", P0, semi=True, size=4)
+    uxy = guards.finite_array("uav_xy", uav_xy, shape=("C", "H", 2), nonempty=True)
+    txy = guards.finite_array("target_xy", target_xy, shape=("T", "H", 2), nonempty=True)
+    if txy.shape[1] != uxy.shape[1]:
+        raise ValueError(
+            f"target_xy must have the horizon of uav_xy (H = {uxy.shape[1]}), got shape {txy.shape}"
+        )
+    guards.real("dt", dt, lo=0.0, lo_open=True)
+    guards.spd_matrix("Q", Q, semi=True, size=4)
+    guards.instance_of("sensor", sensor, SensorModel)
 
 
 def covariance_traces(
@@ -54,8 +79,10 @@ def covariance_traces(
 
     ``P0`` (4, 4) is the current posterior; ``uav_xy`` (C, H, 2); ``target_xy`` (T, H, 2);
     ``Q`` (4, 4) symmetric. With ``return_cov`` also the full covariances (C, T, H, 4, 4)
-    (slow path for tests).
+    (slow path for tests). Arguments are checked by :func:`check_arguments`.
     """
+    check_arguments(P0, uav_xy, target_xy, dt, Q, sensor)
+    Q = np.asarray(Q, dtype=float)
     uav_xy = np.asarray(uav_xy, dtype=float)
     target_xy = np.asarray(target_xy, dtype=float)
     n_c, horizon = uav_xy.shape[:2]

@@ -26,6 +26,7 @@ from typing import Any
 import numpy as np
 from scipy.optimize import Bounds, minimize
 
+from rsmhp import guards
 from rsmhp.uav import fused
 from rsmhp.uav.kinematics import UAVParams
 from rsmhp.uav.sensor import SensorModel
@@ -42,14 +43,16 @@ class PlannerParams:
     maxiter: int
     maxfun: int
 
+    def __post_init__(self) -> None:
+        for name in ("horizon", "maxiter", "maxfun"):
+            value = guards.positive_int(f"PlannerParams.{name}", getattr(self, name))
+            object.__setattr__(self, name, value)  # 6.0 -> 6 (ints are kept as they are)
+
     @classmethod
     def from_config(cls, uav: Mapping[str, Any]) -> PlannerParams:
         p = uav["planner"]
-        return cls(
-            horizon=int(p["horizon"]),
-            maxiter=int(p["maxiter"]),
-            maxfun=int(p["maxfun"]),
-        )
+        # no int(): 6.7 is refused by the constructor rather than truncated to 6
+        return cls(horizon=p["horizon"], maxiter=p["maxiter"], maxfun=p["maxfun"])
 
 
 @dataclass
@@ -69,6 +72,11 @@ class PlanningProblem:
 
     ``value_and_grad(x)`` returns ``(J(x), grad J(x))`` from one compiled kernel call; the
     last result is cached. ``costs(xs)`` evaluates a batch of sequences (values only).
+
+    The arguments are checked once here (``uav_state`` finite (4,) with speed > 0, ``P_hat``
+    finite symmetric positive semidefinite (4, 4), ``target_xy`` finite (T, H, 2) with
+    T >= 1 and H the planner's horizon, and the model types), never per evaluation;
+    ``check=False`` skips this (the closed loop checks its inputs once per run).
     """
 
     def __init__(
@@ -80,7 +88,18 @@ class PlanningProblem:
         target: TargetModel,
         sensor: SensorModel,
         params: PlannerParams,
+        *,
+        check: bool = True,
     ) -> None:
+        if check:
+            guards.instance_of("uav", uav, UAVParams)
+            guards.instance_of("target", target, TargetModel)
+            guards.instance_of("params", params, PlannerParams)
+            guards.instance_of("sensor", sensor, SensorModel)
+            fused.check_uav_state(uav_state)
+            guards.spd_matrix("P_hat", P_hat, semi=True, size=4)
+            H = params.horizon
+            guards.finite_array("target_xy", target_xy, shape=("T", H, 2), nonempty=True)
         self.uav_state = np.asarray(uav_state, dtype=float)
         self.P_hat = np.asarray(P_hat, dtype=float)
         self.target_xy = np.asarray(target_xy, dtype=float)
@@ -89,12 +108,21 @@ class PlanningProblem:
         self.n_kernel_calls = 0
         self._cache: tuple[np.ndarray, float, np.ndarray] | None = None
         self._frozen = fused.Frozen(
-            self.uav_state, uav, self.P_hat, self.target_xy, target.dt, target.Q, sensor
+            self.uav_state,
+            uav,
+            self.P_hat,
+            self.target_xy,
+            target.dt,
+            target.Q,
+            sensor,
+            check=False,
         )
 
     def controls(self, x: np.ndarray) -> np.ndarray:
         """Normalised ``x`` (..., 2H) -> controls (..., H, 2)."""
         x = np.asarray(x, dtype=float)
+        if x.ndim == 0 or x.shape[-1] != self.scale.size:
+            raise ValueError(f"x must have shape (..., {self.scale.size}), got {x.shape}")
         return (x * self.scale).reshape(*x.shape[:-1], self.params.horizon, 2)
 
     def costs(self, xs: np.ndarray) -> np.ndarray:
@@ -121,6 +149,8 @@ class PlanningProblem:
 def shift_plan(controls: np.ndarray) -> np.ndarray:
     """Warm start: drop the applied control, repeat the last one: (H, 2) -> (H, 2)."""
     controls = np.asarray(controls, dtype=float)
+    if controls.ndim != 2 or controls.shape[1] != 2 or controls.shape[0] == 0:
+        raise ValueError(f"controls must have shape (H, 2) with H >= 1, got {controls.shape}")
     return np.vstack([controls[1:], controls[-1:]])
 
 
@@ -134,6 +164,16 @@ def _box(n: int) -> Bounds:
 def lbfgsb(problem: PlanningProblem, x0: np.ndarray, maxiter: int, maxfun: int | None = None):
     """scipy's L-BFGS-B on ``problem`` (exact gradient) over the box [-1, 1]^2H from ``x0``,
     at most ``maxiter`` iterations (and ``maxfun`` evaluations if given); the scipy result."""
+    guards.instance_of("problem", problem, PlanningProblem)
+    n = 2 * problem.params.horizon
+    x0 = guards.finite_array("x0", x0, shape=(n,))
+    maxiter = guards.positive_int("maxiter", maxiter)
+    if maxfun is not None:
+        maxfun = guards.positive_int("maxfun", maxfun)
+    return _lbfgsb(problem, x0, maxiter, maxfun)
+
+
+def _lbfgsb(problem: PlanningProblem, x0: np.ndarray, maxiter: int, maxfun: int | None = None):
     options = {"maxiter": maxiter} if maxfun is None else {"maxiter": maxiter, "maxfun": maxfun}
     return minimize(
         problem.value_and_grad,
@@ -145,11 +185,17 @@ def lbfgsb(problem: PlanningProblem, x0: np.ndarray, maxiter: int, maxfun: int |
     )
 
 
-def plan(problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
-    """Minimise the problem's cost from ``warm_start`` (H, 2) controls with L-BFGS-B."""
+def plan(problem: PlanningProblem, warm_start: np.ndarray, *, check: bool = True) -> PlanResult:
+    """Minimise the problem's cost from ``warm_start`` (H, 2) controls with L-BFGS-B.
+
+    ``check=False`` skips the checks of ``problem`` (a :class:`PlanningProblem`) and
+    ``warm_start`` (finite, shape (H, 2))."""
+    if check:
+        guards.instance_of("problem", problem, PlanningProblem)
+        guards.finite_array("warm_start", warm_start, shape=(problem.params.horizon, 2))
     x0 = np.clip(np.asarray(warm_start, dtype=float).ravel() / problem.scale, -1.0, 1.0)
     f0, _ = problem.value_and_grad(x0)
-    res = lbfgsb(problem, x0, problem.params.maxiter, problem.params.maxfun)
+    res = _lbfgsb(problem, x0, problem.params.maxiter, problem.params.maxfun)
     x_best, f_best = (res.x, float(res.fun)) if res.fun <= f0 else (x0, f0)
     controls = problem.controls(x_best)
     return PlanResult(

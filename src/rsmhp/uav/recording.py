@@ -31,6 +31,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from rsmhp import guards
 from rsmhp.seeding import canonical_job_id
 from rsmhp.uav.simulation import MethodSpec, StepInfo, UAVSetup, draw_scenario, simulate_run
 
@@ -46,7 +47,13 @@ MISSED_C = (210, 40, 40)
 
 
 def ellipse_polygon(mean: np.ndarray, cov: np.ndarray, n_sigma: float = 2.0, n: int = 48):
-    """Closed polygon (n + 1, 2) of the ``n_sigma`` ellipse of a 2-D Gaussian."""
+    """Closed polygon (n + 1, 2) of the ``n_sigma`` ellipse of a 2-D Gaussian: ``mean``
+    finite (2,), ``cov`` finite symmetric positive definite (2, 2), ``n_sigma`` > 0,
+    ``n`` >= 3 polygon sides."""
+    guards.finite_array("mean", mean, shape=(2,))
+    guards.spd_matrix("cov", cov, size=2)
+    guards.real("n_sigma", n_sigma, lo=0.0, lo_open=True)
+    n = guards.integer("n", n, minimum=3)
     L = np.linalg.cholesky(0.5 * (cov + cov.T))
     t = np.linspace(0.0, 2 * np.pi, n + 1)
     return np.asarray(mean)[None, :] + n_sigma * np.column_stack([np.cos(t), np.sin(t)]) @ L.T
@@ -124,6 +131,15 @@ def record_uav_run(
     Returns (entity path -> logged rows, the per-method summary rows of the simulations, which
     equal those of the Monte-Carlo study for the same run).
     """
+    guards.instance_of("setup", setup, UAVSetup)
+    methods = list(methods)
+    if not methods:
+        raise ValueError("methods must name at least one MethodSpec, got none")
+    for i, m in enumerate(methods):
+        guards.instance_of(f"methods[{i}]", m, MethodSpec)
+    seed = guards.nonneg_int("seed", seed)
+    run = guards.nonneg_int("run", run)
+    max_hypotheses = guards.nonneg_int("max_hypotheses", max_hypotheses)
     names = [m.name for m in methods]
     variant = {} if not setup.sensor.limited else {"footprint": setup.sensor.footprint_radius}
     job = canonical_job_id("uav_recording", seed=seed, run=run, methods=names, **variant)

@@ -44,6 +44,8 @@ from typing import Any
 
 import numpy as np
 
+from rsmhp import guards
+
 __all__ = [
     "GROWTHS",
     "SensorModel",
@@ -76,26 +78,18 @@ class SensorModel:
 
     def __post_init__(self) -> None:
         for name in ("sigma_r_per_m", "sigma_c_per_m", "altitude", "reference_distance"):
-            value = getattr(self, name)
-            if not (np.isfinite(value) and value > 0):
-                raise ValueError(f"SensorModel.{name} must be finite and > 0, got {value!r}")
-        if self.noise_growth not in GROWTHS:
-            raise ValueError(
-                f"SensorModel.noise_growth must be one of {GROWTHS}, got {self.noise_growth!r}"
-            )
-        if self.detection not in DETECTIONS:
-            raise ValueError(
-                f"SensorModel.detection must be one of {DETECTIONS}, got {self.detection!r}"
-            )
-        if not self.footprint_radius > 0 or np.isnan(self.footprint_radius):
-            raise ValueError(
-                f"SensorModel.footprint_radius must be > 0 (inf: unlimited), "
-                f"got {self.footprint_radius!r}"
-            )
-        if not (np.isfinite(self.footprint_width) and self.footprint_width > 0):
-            raise ValueError(
-                f"SensorModel.footprint_width must be finite and > 0, got {self.footprint_width!r}"
-            )
+            guards.real(f"SensorModel.{name}", getattr(self, name), lo=0.0, lo_open=True)
+        guards.one_of("SensorModel.noise_growth", self.noise_growth, GROWTHS)
+        guards.one_of("SensorModel.detection", self.detection, DETECTIONS)
+        # inf: unlimited
+        guards.real(
+            "SensorModel.footprint_radius",
+            self.footprint_radius,
+            lo=0.0,
+            lo_open=True,
+            finite=False,
+        )
+        guards.real("SensorModel.footprint_width", self.footprint_width, lo=0.0, lo_open=True)
 
     @property
     def limited(self) -> bool:
@@ -131,11 +125,37 @@ def _geometry(uav_xy: np.ndarray, target_xy: np.ndarray, altitude: float):
     return rho2 + altitude * altitude, c, s
 
 
+def _check_xy(
+    sensor: SensorModel,
+    uav_xy: np.ndarray,
+    target_xy: np.ndarray,
+    std_normal: np.ndarray | None = None,
+) -> None:
+    """Cheap checks of the geometry helpers' arguments (once per call, no pass over the
+    values: the helpers are elementwise, so NaN stays NaN): ``sensor`` is a
+    :class:`SensorModel` and every array has a last axis of 2 entries."""
+    if not isinstance(sensor, SensorModel):
+        guards.instance_of("sensor", sensor, SensorModel)
+    for name, a in (("uav_xy", uav_xy), ("target_xy", target_xy), ("std_normal", std_normal)):
+        if a is None and name == "std_normal":
+            continue
+        shape = a.shape if isinstance(a, np.ndarray) else np.shape(a)
+        if not shape or shape[-1] != 2:
+            raise ValueError(f"{name} must have shape (..., 2), got {shape}")
+
+
 def measurement_cov_entries(
     uav_xy: np.ndarray, target_xy: np.ndarray, sensor: SensorModel
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """``(R_xx, R_xy, R_yy)``, each of the broadcast shape of ``uav_xy[..., 0]`` and
     ``target_xy[..., 0]`` (m²)."""
+    _check_xy(sensor, uav_xy, target_xy)
+    return _measurement_cov_entries(uav_xy, target_xy, sensor)
+
+
+def _measurement_cov_entries(
+    uav_xy: np.ndarray, target_xy: np.ndarray, sensor: SensorModel
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     d2, c, s = _geometry(np.asarray(uav_xy), np.asarray(target_xy), sensor.altitude)
     fr2, fc2 = sensor.sigma_r_per_m**2, sensor.sigma_c_per_m**2
     if sensor.noise_growth == "quadratic":
@@ -148,7 +168,8 @@ def measurement_cov_entries(
 
 def measurement_cov(uav_xy: np.ndarray, target_xy: np.ndarray, sensor: SensorModel) -> np.ndarray:
     """R as ``(..., 2, 2)`` matrices."""
-    rxx, rxy, ryy = measurement_cov_entries(uav_xy, target_xy, sensor)
+    _check_xy(sensor, uav_xy, target_xy)
+    rxx, rxy, ryy = _measurement_cov_entries(uav_xy, target_xy, sensor)
     return np.stack([np.stack([rxx, rxy], -1), np.stack([rxy, ryy], -1)], -2)
 
 
@@ -161,6 +182,7 @@ def measurement_noise(
     Methods share :math:`\zeta` (paired design); :math:`v` itself depends on each method's
     geometry.
     """
+    _check_xy(sensor, uav_xy, target_xy, std_normal)
     d2, c, s = _geometry(np.asarray(uav_xy), np.asarray(target_xy), sensor.altitude)
     d = np.sqrt(d2)
     if sensor.noise_growth == "quadratic":
@@ -175,6 +197,13 @@ def detection_probability(
 ) -> np.ndarray:
     r"""The planner's :math:`p_d = 1/(1 + e^{(\rho - \rho_0)/w})` (broadcast shape of the
     positions' leading axes); 1 without a footprint."""
+    _check_xy(sensor, uav_xy, target_xy)
+    return _detection_probability(uav_xy, target_xy, sensor)
+
+
+def _detection_probability(
+    uav_xy: np.ndarray, target_xy: np.ndarray, sensor: SensorModel
+) -> np.ndarray:
     uav_xy, target_xy = np.asarray(uav_xy, dtype=float), np.asarray(target_xy, dtype=float)
     rho = np.hypot(target_xy[..., 0] - uav_xy[..., 0], target_xy[..., 1] - uav_xy[..., 1])
     if not sensor.limited:
@@ -186,9 +215,16 @@ def detection_probability(
 def detected(uav_xy: np.ndarray, target_xy: np.ndarray, sensor: SensorModel, u: float) -> bool:
     """Whether the truth simulation gets a measurement: always without a footprint; with one,
     ``rho <= rho_0`` (``hard``) or ``u < p_d(rho)`` for a uniform ``u`` (``logistic``)."""
+    _check_xy(sensor, uav_xy, target_xy)
+    if np.shape(uav_xy) != (2,) or np.shape(target_xy) != (2,):
+        raise ValueError(
+            f"uav_xy and target_xy must have shape (2,) (one position each), got "
+            f"{np.shape(uav_xy)} and {np.shape(target_xy)}"
+        )
     if not sensor.limited:
         return True
     if sensor.detection == "hard":
         rho = float(np.hypot(target_xy[0] - uav_xy[0], target_xy[1] - uav_xy[1]))
         return rho <= sensor.footprint_radius
-    return bool(u < float(detection_probability(uav_xy, target_xy, sensor)))
+    guards.probability("u", u)
+    return bool(u < float(_detection_probability(uav_xy, target_xy, sensor)))

@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 from threadpoolctl import threadpool_limits
 
+from rsmhp import guards
 from rsmhp.seeding import job_rng
 from rsmhp.uav import kinematics, sensor, target
 from rsmhp.uav.kinematics import UAVParams
@@ -68,6 +69,8 @@ __all__ = [
     "simulate_run",
 ]
 
+FAMILIES = ("nbo", "rsmhp", "tree")
+
 
 @dataclass(frozen=True)
 class MethodSpec:
@@ -80,6 +83,38 @@ class MethodSpec:
     n_branch: int | None = None
     max_keep: int | None = None
 
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise TypeError(
+                f"MethodSpec.name must be a non-empty string, got {type(self.name).__name__} "
+                f"{self.name!r}"
+            )
+        if not self.name:
+            raise ValueError("MethodSpec.name must be a non-empty string, got ''")
+        guards.one_of("MethodSpec.family", self.family, FAMILIES)
+        # whole-number floats become ints (1.0 and 1 already name the same random streams)
+        n_traj = guards.positive_int("MethodSpec.n_traj (N_T)", self.n_traj)
+        object.__setattr__(self, "n_traj", n_traj)
+        if self.family == "nbo" and n_traj != 1:
+            raise ValueError(
+                f"MethodSpec.n_traj (N_T) must be 1 for the nbo family (one nominal "
+                f"hypothesis), got {n_traj}"
+            )
+        for attr, label in (("n_branch", "N"), ("max_keep", "M")):
+            value = getattr(self, attr)
+            name = f"MethodSpec.{attr} ({label})"
+            if self.family == "tree":
+                if value is None:
+                    raise ValueError(
+                        f"{name} must be an integer >= 1 for the tree family, got None"
+                    )
+                object.__setattr__(self, attr, guards.positive_int(name, value))
+            elif value is not None:
+                raise ValueError(
+                    f"{name} must be None for the {self.family} family (only the tree uses it), "
+                    f"got {value!r}"
+                )
+
     def job_params(self) -> dict[str, Any]:
         """The method's part of a job identifier."""
         return {"method": self.name, "N_T": self.n_traj, "N": self.n_branch, "M": self.max_keep}
@@ -89,14 +124,18 @@ def method_specs(uav: Mapping[str, Any]) -> dict[str, MethodSpec]:
     """Methods of the ``uav.methods`` config section, keyed by name (the rule wildcard):
     ``nbo``, ``rsmhp_nt<N_T>`` for each N_T, ``tree_n<N>_m<M>`` for each tree ablation."""
     m = uav["methods"]
+    guards.instance_of("uav.methods.nbo", m["nbo"], (bool, np.bool_))
     out: dict[str, MethodSpec] = {}
     if m["nbo"]:
         out["nbo"] = MethodSpec("nbo", "nbo", 1)
-    for n in m["rsmhp_nt"]:
+    for i, n in enumerate(m["rsmhp_nt"]):
+        n = guards.positive_int(f"uav.methods.rsmhp_nt[{i}]", n)
         out[f"rsmhp_nt{n}"] = MethodSpec(f"rsmhp_nt{n}", "rsmhp", int(n))
-    for t in m["tree"]:
-        name = f"tree_n{t['N']}_m{t['M']}"
-        out[name] = MethodSpec(name, "tree", int(t["M"]), int(t["N"]), int(t["M"]))
+    for i, t in enumerate(m["tree"]):
+        N = guards.positive_int(f"uav.methods.tree[{i}].N", t["N"])
+        M = guards.positive_int(f"uav.methods.tree[{i}].M", t["M"])
+        name = f"tree_n{N}_m{M}"
+        out[name] = MethodSpec(name, "tree", int(M), int(N), int(M))
     return out
 
 
@@ -112,6 +151,16 @@ class UAVSetup:
     steps: int
     scenario: Mapping[str, float]
 
+    def __post_init__(self) -> None:
+        guards.instance_of("UAVSetup.uav", self.uav, UAVParams)
+        guards.instance_of("UAVSetup.target", self.target, TargetModel)
+        guards.instance_of("UAVSetup.sensor", self.sensor, SensorModel)
+        guards.instance_of("UAVSetup.planner", self.planner, PlannerParams)
+        # positive definite: the scenario's initial estimate error uses its Cholesky factor
+        guards.spd_matrix("UAVSetup.P0", self.P0, size=4)
+        object.__setattr__(self, "steps", guards.positive_int("UAVSetup.steps", self.steps))
+        _check_scenario(self.scenario)
+
     @classmethod
     def from_config(cls, uav: Mapping[str, Any]) -> UAVSetup:
         tr = uav["tracker"]
@@ -122,9 +171,38 @@ class UAVSetup:
             sensor=SensorModel.from_config(uav),
             planner=PlannerParams.from_config(uav),
             P0=P0,
-            steps=int(uav["scenario"]["steps"]),
+            steps=uav["scenario"]["steps"],  # checked (not truncated) by the constructor
             scenario=dict(uav["scenario"]),
         )
+
+
+SCENARIO_KEYS = (
+    "target_box",
+    "target_speed_min",
+    "target_speed_max",
+    "uav_distance_min",
+    "uav_distance_max",
+    "uav_speed",
+)
+
+
+def _check_scenario(sc: Mapping[str, Any]) -> None:
+    """The scenario ranges :func:`draw_scenario` draws from: every key present and finite,
+    ``target_box``, speeds and distances >= 0, ``uav_speed`` > 0, each min <= its max."""
+    guards.instance_of("UAVSetup.scenario", sc, Mapping)
+    missing = [k for k in SCENARIO_KEYS if k not in sc]
+    if missing:
+        raise ValueError(f"UAVSetup.scenario is missing {missing} (needs {list(SCENARIO_KEYS)})")
+    for key in SCENARIO_KEYS:
+        if key == "uav_speed":
+            guards.real(f"scenario.{key}", sc[key], lo=0.0, lo_open=True)
+        else:
+            guards.real(f"scenario.{key}", sc[key], lo=0.0)
+    for lo, hi in (
+        ("target_speed_min", "target_speed_max"),
+        ("uav_distance_min", "uav_distance_max"),
+    ):
+        guards.ordered(f"scenario.{lo}", sc[lo], f"scenario.{hi}", sc[hi], strict=False)
 
 
 @dataclass(frozen=True)
@@ -138,6 +216,9 @@ class Scenario:
 
 def draw_scenario(setup: UAVSetup, seed: int, run: int) -> Scenario:
     """The run's scenario (see the module docstring for the draw order)."""
+    guards.instance_of("setup", setup, UAVSetup)
+    seed = guards.nonneg_int("seed", seed)
+    run = guards.nonneg_int("run", run)
     sc = setup.scenario
     rng = job_rng(seed, "uav_scenario", run=run)
     pos = rng.uniform(-sc["target_box"], sc["target_box"], 2)
@@ -174,14 +255,18 @@ class StepInfo:
 def _hypotheses(
     method: MethodSpec, x_hat: np.ndarray, P_hat: np.ndarray, setup: UAVSetup, rng
 ) -> np.ndarray:
+    """The method's hypotheses at one planning step, unchecked (the arguments come from a
+    checked setup and method and the run's own tracker)."""
     H = setup.planner.horizon
     if method.family == "nbo":
-        return target.nominal(x_hat, H, setup.target)
+        return target.nominal(x_hat, H, setup.target, check=False)
     if method.family == "rsmhp":
-        return target.sample_independent(x_hat, P_hat, H, method.n_traj, setup.target, rng)
+        return target.sample_independent(
+            x_hat, P_hat, H, method.n_traj, setup.target, rng, check=False
+        )
     if method.family == "tree":
         states, _ = target.sample_tree(
-            x_hat, P_hat, H, method.n_branch, method.max_keep, setup.target, rng
+            x_hat, P_hat, H, method.n_branch, method.max_keep, setup.target, rng, check=False
         )
         return states
     raise ValueError(f"unknown method family {method.family!r}")
@@ -198,7 +283,17 @@ def simulate_run(
 
     BLAS is limited to one thread for the run: the planner's small dense algebra (scipy's
     L-BFGS-B on 2H variables) is many times slower with a multi-threaded BLAS pool.
+
+    The arguments are checked here, once per run (``setup`` and ``method`` were checked when
+    they were built); the steps of the run then call the planner, the hypothesis generators
+    and the tracker with ``check=False``.
     """
+    guards.instance_of("setup", setup, UAVSetup)
+    guards.instance_of("method", method, MethodSpec)
+    seed = guards.nonneg_int("seed", seed)
+    run = guards.nonneg_int("run", run)
+    if observer is not None and not callable(observer):
+        raise TypeError(f"observer must be callable or None, got {type(observer).__name__}")
     with threadpool_limits(limits=1):
         return _simulate_run(setup, method, seed, run, observer)
 
@@ -224,9 +319,16 @@ def _simulate_run(setup, method, seed, run, observer):
         rng = job_rng(seed, "uav_plan", run=run, step=k, **method.job_params())
         hyp = _hypotheses(method, x_hat, P_hat, setup, rng)
         problem = PlanningProblem(
-            uav_state, P_hat, hyp[..., :2], setup.uav, setup.target, setup.sensor, setup.planner
+            uav_state,
+            P_hat,
+            hyp[..., :2],
+            setup.uav,
+            setup.target,
+            setup.sensor,
+            setup.planner,
+            check=False,
         )
-        res = plan(problem, warm)
+        res = plan(problem, warm, check=False)
         plan_seconds += time.perf_counter() - t0
         warm = shift_plan(res.controls)
         uav_state = kinematics.step(uav_state, res.controls[0], setup.uav)
@@ -236,7 +338,7 @@ def _simulate_run(setup, method, seed, run, observer):
         if seen:
             R_est = sensor.measurement_cov(uav_state[:2], trk.x[:2], setup.sensor)
             v = sensor.measurement_noise(uav_state[:2], x_true[:2], setup.sensor, zeta[k - 1])
-            trk.update(x_true[:2] + v, R_est)
+            trk.update(x_true[:2] + v, R_est, check=False)
             n_detected += 1
         x_est, P_est = trk.x, trk.P
         err = float(np.hypot(*(x_est[:2] - x_true[:2])))

@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 from numba import njit
 
+from rsmhp import guards
 from rsmhp.sampling import GaussianNoise, top_m
 from rsmhp.sampling import sample_tree as _sample_tree
 
@@ -57,14 +58,26 @@ __all__ = [
 
 
 def transition_matrix(dt: float) -> np.ndarray:
-    """NCV transition matrix F (4, 4)."""
+    """NCV transition matrix F (4, 4); ``dt`` > 0."""
+    guards.real("dt", dt, lo=0.0, lo_open=True)
+    return _transition_matrix(dt)
+
+
+def _transition_matrix(dt: float) -> np.ndarray:
     F = np.eye(4)
     F[0, 2] = F[1, 3] = dt
     return F
 
 
 def process_noise(dt: float, q: float) -> np.ndarray:
-    """NCV process-noise covariance Q (4, 4), white-noise acceleration of intensity ``q``."""
+    """NCV process-noise covariance Q (4, 4), white-noise acceleration of intensity ``q``
+    (``dt`` > 0, ``q`` >= 0)."""
+    guards.real("dt", dt, lo=0.0, lo_open=True)
+    guards.real("q", q, lo=0.0)
+    return _process_noise(dt, q)
+
+
+def _process_noise(dt: float, q: float) -> np.ndarray:
     Q = np.zeros((4, 4))
     for i in range(2):
         Q[i, i] = dt**3 / 3
@@ -80,17 +93,22 @@ class TargetModel:
     dt: float
     q: float
 
+    def __post_init__(self) -> None:
+        guards.real("TargetModel.dt", self.dt, lo=0.0, lo_open=True)
+        # q = 0 makes Q singular: no Cholesky factor for the truth noise and the hypotheses
+        guards.real("TargetModel.q", self.q, lo=0.0, lo_open=True)
+
     @classmethod
     def from_config(cls, uav: Mapping[str, Any]) -> TargetModel:
         return cls(dt=float(uav["dt"]), q=float(uav["target"]["q"]))
 
     @property
     def F(self) -> np.ndarray:
-        return transition_matrix(self.dt)
+        return _transition_matrix(self.dt)
 
     @property
     def Q(self) -> np.ndarray:
-        return process_noise(self.dt, self.q)
+        return _process_noise(self.dt, self.q)
 
     @cached_property
     def noise(self) -> GaussianNoise:
@@ -139,8 +157,26 @@ def _propagate(x0: np.ndarray, w: np.ndarray, F: np.ndarray) -> np.ndarray:
     return out
 
 
-def nominal(x_hat: np.ndarray, horizon: int, model: TargetModel) -> np.ndarray:
-    """NBO hypothesis: ``(1, H, 4)`` with :math:`x_j = F^j \\hat x`."""
+def _check_estimate(
+    x_hat: np.ndarray, P_hat: np.ndarray | None, horizon: int, model: TargetModel
+) -> int:
+    """The arguments every hypothesis generator shares; returns ``horizon`` (an int)."""
+    guards.finite_array("x_hat", x_hat, shape=(4,))
+    if P_hat is not None:
+        guards.spd_matrix("P_hat", P_hat, size=4)
+    guards.instance_of("model", model, TargetModel)
+    return guards.positive_int("horizon", horizon)
+
+
+def nominal(
+    x_hat: np.ndarray, horizon: int, model: TargetModel, *, check: bool = True
+) -> np.ndarray:
+    """NBO hypothesis: ``(1, H, 4)`` with :math:`x_j = F^j \\hat x`.
+
+    ``check=False`` skips the argument checks (the closed loop, whose inputs are checked
+    once per run, plans with it)."""
+    if check:
+        horizon = _check_estimate(x_hat, None, horizon, model)
     x0 = np.asarray(x_hat, dtype=float).reshape(1, 4)
     return _propagate(x0, np.zeros((1, horizon, 4)), model.F)
 
@@ -152,12 +188,18 @@ def sample_independent(
     n: int,
     model: TargetModel,
     rng: np.random.Generator,
+    *,
+    check: bool = True,
 ) -> np.ndarray:
     """``n`` non-overlapping hypotheses ``(n, H, 4)``.
 
     Stream order: ``n x 4`` standard normals for the initial states, then ``n x H x 4`` for the
-    process noise.
+    process noise. ``check=False`` skips the argument checks (see :func:`nominal`).
     """
+    if check:
+        horizon = _check_estimate(x_hat, P_hat, horizon, model)
+        n = guards.positive_int("n", n)
+        guards.generator("rng", rng)
     z0 = rng.standard_normal((n, 4))
     x0 = np.asarray(x_hat, dtype=float) + z0 @ _chol(P_hat).T
     w = rng.standard_normal((n, horizon, 4)) @ _chol(model.Q).T
@@ -191,16 +233,23 @@ def _tree_levels(
     P_hat: np.ndarray, horizon: int, n_branch: int, max_keep: int, model: TargetModel
 ) -> list[GaussianNoise]:
     """Checked arguments; the noise model of every level (H + 1): initial state, then Q."""
-    if horizon < 1:
-        raise ValueError(f"horizon must be >= 1, got {horizon}")
-    if n_branch < 1:
-        raise ValueError(f"N (draws per level) must be >= 1, got {n_branch}")
-    if max_keep < 1:
-        raise ValueError(f"M (trajectories kept) must be >= 1, got {max_keep}")
+    guards.positive_int("horizon", horizon)
+    guards.positive_int("N (draws per level)", n_branch)
+    guards.positive_int("M (trajectories kept)", max_keep)
     P_hat = np.asarray(P_hat, dtype=float)
     if P_hat.shape != (4, 4):
         raise ValueError(f"P_hat must have shape (4, 4), got {P_hat.shape}")
     return [HypothesisNoise(0.5 * (P_hat + P_hat.T))] + [model.noise] * horizon
+
+
+def _check_tree(x_hat, P_hat, horizon, n_branch, max_keep, model, rng) -> tuple[int, int, int]:
+    """The tree generators' arguments; returns ``(horizon, N, M)`` as integers."""
+    horizon = _check_estimate(x_hat, None, horizon, model)
+    n_branch = guards.positive_int("N (draws per level)", n_branch)
+    max_keep = guards.positive_int("M (trajectories kept)", max_keep)
+    guards.spd_matrix("P_hat", P_hat, size=4)
+    guards.generator("rng", rng)
+    return horizon, n_branch, max_keep
 
 
 @njit(cache=True, inline="always")
@@ -305,6 +354,8 @@ def sample_tree(
     max_keep: int,
     model: TargetModel,
     rng: np.random.Generator,
+    *,
+    check: bool = True,
 ) -> tuple[np.ndarray, np.ndarray]:
     r"""Pruned tree of hypotheses: ``(states (m, H, 4), log_likeliness (m,))``, ``m <= M``.
 
@@ -313,8 +364,14 @@ def sample_tree(
     P)`, levels ``1..H`` draw ``N`` process-noise values :math:`w \sim \mathcal N(0, Q)`
     shared by all nodes; after every level the ``M`` most likely trajectories are kept.
     Survivors are returned sorted by decreasing likeliness (ties by tree order). Compiled;
-    equal to :func:`sample_tree_reference` (see the module docstring).
+    equal to :func:`sample_tree_reference` (see the module docstring). ``check=False``
+    skips the checks of ``x_hat``, ``P_hat`` (finite, positive definite), ``model`` and
+    ``rng`` (see :func:`nominal`).
     """
+    if check:
+        horizon, n_branch, max_keep = _check_tree(
+            x_hat, P_hat, horizon, n_branch, max_keep, model, rng
+        )
     levels = _tree_levels(P_hat, horizon, n_branch, max_keep, model)
     # one call draws the same stream as the reference's level-by-level calls
     z = rng.standard_normal((horizon + 1, n_branch, 4))
@@ -338,6 +395,7 @@ def sample_tree_reference(
 ) -> tuple[np.ndarray, np.ndarray]:
     """:func:`sample_tree` through the generic :func:`rsmhp.sampling.sample_tree` (the
     plain reference implementation, used as the test oracle)."""
+    horizon, n_branch, max_keep = _check_tree(x_hat, P_hat, horizon, n_branch, max_keep, model, rng)
     levels = _tree_levels(P_hat, horizon, n_branch, max_keep, model)
     system = _Hypotheses(F=model.F, noise=model.noise)
     tree = _sample_tree(

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 from filterpy.kalman import KalmanFilter
 
+from rsmhp import guards
 from rsmhp.uav.target import TargetModel
 
 __all__ = ["MEASUREMENT_MATRIX", "Tracker"]
@@ -19,9 +20,14 @@ MEASUREMENT_MATRIX = np.hstack([np.eye(2), np.zeros((2, 2))])
 
 
 class Tracker:
-    """Thin wrapper: state ``x`` (4,), covariance ``P`` (4, 4), ``predict()``, ``update(z, R)``."""
+    """Thin wrapper: state ``x`` (4,), covariance ``P`` (4, 4), ``predict()``, ``update(z, R)``.
+
+    ``x0`` finite (4,), ``P0`` finite symmetric positive semidefinite (4, 4)."""
 
     def __init__(self, x0: np.ndarray, P0: np.ndarray, model: TargetModel) -> None:
+        guards.finite_array("x0", x0, shape=(4,))
+        guards.spd_matrix("P0", P0, semi=True, size=4)
+        guards.instance_of("model", model, TargetModel)
         kf = KalmanFilter(dim_x=4, dim_z=2)
         kf.F = model.F
         kf.Q = model.Q
@@ -41,6 +47,13 @@ class Tracker:
     def predict(self) -> None:
         self.kf.predict()
 
-    def update(self, z: np.ndarray, R: np.ndarray) -> None:
-        """Measurement update; ``z`` (2,) is passed to filterpy as a (2, 1) column."""
+    def update(self, z: np.ndarray, R: np.ndarray, *, check: bool = True) -> None:
+        """Measurement update; ``z`` (2,) is passed to filterpy as a (2, 1) column. ``z`` must
+        be finite with 2 entries and ``R`` finite symmetric positive semidefinite (2, 2)
+        (``check=False`` skips this, for a caller that builds them itself)."""
+        if check:
+            zz = guards.finite_array("z", z)
+            if zz.size != 2:
+                raise ValueError(f"z must have 2 entries (a position), got shape {zz.shape}")
+            guards.spd_matrix("R", R, semi=True, size=2)
         self.kf.update(np.asarray(z, dtype=float).reshape(2, 1), R=np.asarray(R, dtype=float))
