@@ -110,8 +110,9 @@ def _kalman_step(p, rxx, rxy, ryy, dt, q, pd, limited):  # pragma: no cover - co
     """One predict + update of the 10 distinct entries ``p`` of P (order a11, a12, a22, b11,
     b12, b21, b22, c11, c12, c22; ``q`` likewise for Q). Returns (P+, M, N, X) with M = S^-1
     A^-, N = S^-1 B^- as 4-tuples (row-major) and X = K S K^T (10 entries). Without a
-    footprint (``limited`` False) P+ = P^- - X, the same arithmetic as rsmhp.uav.kernel;
-    with one, the expected update P+ = P^- - p_d X."""
+    footprint (``limited`` False) P+ = P^- - X, evaluated as A+ = R M, B+ = R N, C+ = C^- -
+    X_C (the same arithmetic as rsmhp.uav.kernel); with one, the expected update P+ = P^- -
+    p_d X = (1 - p_d) P^- + p_d (P^- - X)."""
     a11, a12, a22, b11, b12, b21, b22, c11, c12, c22 = p
     dt2 = dt * dt
     pa11 = a11 + 2 * dt * b11 + dt2 * c11 + q[0]
@@ -147,28 +148,39 @@ def _kalman_step(p, rxx, rxy, ryy, dt, q, pd, limited):  # pragma: no cover - co
         pb11 * n12 + pb21 * n22,
         pb12 * n12 + pb22 * n22,
     )
-    if limited:
+    # Position and cross blocks in the cancellation-free form A+ = A- - A- S^-1 A- = R S^-1 A-
+    # = R M and B+ = R N (S - A- = R); the subtraction A- - A- M loses every digit when R is
+    # tiny next to A- (tests/test_properties.py). The velocity block keeps C- - B-^T N.
+    ra11 = rxx * m11 + rxy * m21
+    ra12 = rxx * m12 + rxy * m22
+    ra22 = rxy * m12 + ryy * m22
+    rb11 = rxx * n11 + rxy * n21
+    rb12 = rxx * n12 + rxy * n22
+    rb21 = rxy * n11 + ryy * n21
+    rb22 = rxy * n12 + ryy * n22
+    if limited:  # expected update (1 - p_d) P- + p_d P+
+        qd = 1.0 - pd
         out = (
-            pa11 - pd * x[0],
-            pa12 - pd * x[1],
-            pa22 - pd * x[2],
-            pb11 - pd * x[3],
-            pb12 - pd * x[4],
-            pb21 - pd * x[5],
-            pb22 - pd * x[6],
+            qd * pa11 + pd * ra11,
+            qd * pa12 + pd * ra12,
+            qd * pa22 + pd * ra22,
+            qd * pb11 + pd * rb11,
+            qd * pb12 + pd * rb12,
+            qd * pb21 + pd * rb21,
+            qd * pb22 + pd * rb22,
             pc11 - pd * x[7],
             pc12 - pd * x[8],
             pc22 - pd * x[9],
         )
     else:
         out = (
-            pa11 - x[0],
-            pa12 - x[1],
-            pa22 - x[2],
-            pb11 - x[3],
-            pb12 - x[4],
-            pb21 - x[5],
-            pb22 - x[6],
+            ra11,
+            ra12,
+            ra22,
+            rb11,
+            rb12,
+            rb21,
+            rb22,
             pc11 - x[7],
             pc12 - x[8],
             pc22 - x[9],

@@ -18,17 +18,22 @@ Structure used (exact, not approximations): write :math:`P = [[A, B], [B^T, C]]`
 .. math::
     A^- = A + \Delta t (B + B^T) + \Delta t^2 C + Q_A, \quad B^- = B + \Delta t C + Q_B,
     \quad C^- = C + Q_C, \\
-    S = A^- + R, \quad A^+ = A^- - A^- S^{-1} A^-, \quad B^+ = B^- - A^- S^{-1} B^-,
-    \quad C^+ = C^- - B^{-T} S^{-1} B^-,
+    S = A^- + R, \quad A^+ = A^- - A^- S^{-1} A^- = R S^{-1} A^-, \quad
+    B^+ = B^- - A^- S^{-1} B^- = R S^{-1} B^-, \quad C^+ = C^- - B^{-T} S^{-1} B^-,
 
 with the closed-form 2x2 inverse :math:`S^{-1} = \mathrm{adj}(S)/\det S`. The 10 distinct
 entries of P are carried as arrays of shape (C, T); only upper triangles of the symmetric
-blocks are formed, so symmetry holds exactly. The form :math:`P^- - K S K^T` (not Joseph)
-is used; it agrees with filterpy's Joseph form to rounding error.
+blocks are formed, so symmetry holds exactly. :math:`A^+` and :math:`B^+` are evaluated as
+:math:`R S^{-1} A^-` and :math:`R S^{-1} B^-` (equal because :math:`S - A^- = R`): the
+difference :math:`A^- - A^- S^{-1} A^-` cancels catastrophically when R is tiny next to
+:math:`A^-` (error about :math:`u\,\kappa(S)\,\|P^-\|`; with :math:`A^-` ~ 1e8 m^2 and R ~
+1e-4 m^2 it gave a negative trace), the product does not. It agrees with filterpy's Joseph
+form to rounding error (tests/test_properties.py).
 
 With a sensor footprint (:class:`rsmhp.uav.sensor.SensorModel`) the update is the expected
-one, :math:`P^+ = P^- - p_d\, K S K^T` with :math:`p_d = p_d(\mathrm{uav}_{c,j},
-\mathrm{target}_{i,j})`: :math:`p_d = 0` is a prediction only (no measurement).
+one, :math:`P^+ = P^- - p_d\, K S K^T = (1 - p_d) P^- + p_d (P^- - K S K^T)` with
+:math:`p_d = p_d(\mathrm{uav}_{c,j}, \mathrm{target}_{i,j})`: :math:`p_d = 0` is a
+prediction only (no measurement).
 """
 
 from __future__ import annotations
@@ -132,27 +137,28 @@ def covariance_traces(
         n12 = i11 * pb12 + i12 * pb22
         n21 = i12 * pb11 + i22 * pb21
         n22 = i12 * pb12 + i22 * pb22
-        # update: A+ = A- - A- M, B+ = B- - A- N, C+ = C- - B-^T N
+        # update: A+ = A- - A- M = R M, B+ = B- - A- N = R N (as S - A- = R: no cancellation
+        # when R is tiny next to A-), C+ = C- - B-^T N
+        r11, r12, r22 = rxx[:, :, j], rxy[:, :, j], ryy[:, :, j]
+        ra11 = r11 * m11 + r12 * m21
+        ra12 = r11 * m12 + r12 * m22
+        ra22 = r12 * m12 + r22 * m22
+        rb11 = r11 * n11 + r12 * n21
+        rb12 = r11 * n12 + r12 * n22
+        rb21 = r12 * n11 + r22 * n21
+        rb22 = r12 * n12 + r22 * n22
         if pd is None:
-            a11 = pa11 - (pa11 * m11 + pa12 * m21)
-            a12 = pa12 - (pa11 * m12 + pa12 * m22)
-            a22 = pa22 - (pa12 * m12 + pa22 * m22)
-            b11 = pb11 - (pa11 * n11 + pa12 * n21)
-            b12 = pb12 - (pa11 * n12 + pa12 * n22)
-            b21 = pb21 - (pa12 * n11 + pa22 * n21)
-            b22 = pb22 - (pa12 * n12 + pa22 * n22)
+            a11, a12, a22 = ra11, ra12, ra22
+            b11, b12, b21, b22 = rb11, rb12, rb21, rb22
             c11 = pc11 - (pb11 * n11 + pb21 * n21)
             c12 = pc12 - (pb11 * n12 + pb21 * n22)
             c22 = pc22 - (pb12 * n12 + pb22 * n22)
-        else:  # expected update P- - p_d K S K^T
+        else:  # expected update P- - p_d K S K^T = (1 - p_d) P- + p_d (P- - K S K^T)
             p = pd[:, :, j]
-            a11 = pa11 - p * (pa11 * m11 + pa12 * m21)
-            a12 = pa12 - p * (pa11 * m12 + pa12 * m22)
-            a22 = pa22 - p * (pa12 * m12 + pa22 * m22)
-            b11 = pb11 - p * (pa11 * n11 + pa12 * n21)
-            b12 = pb12 - p * (pa11 * n12 + pa12 * n22)
-            b21 = pb21 - p * (pa12 * n11 + pa22 * n21)
-            b22 = pb22 - p * (pa12 * n12 + pa22 * n22)
+            qd = 1.0 - p
+            a11, a12, a22 = qd * pa11 + p * ra11, qd * pa12 + p * ra12, qd * pa22 + p * ra22
+            b11, b12 = qd * pb11 + p * rb11, qd * pb12 + p * rb12
+            b21, b22 = qd * pb21 + p * rb21, qd * pb22 + p * rb22
             c11 = pc11 - p * (pb11 * n11 + pb21 * n21)
             c12 = pc12 - p * (pb11 * n12 + pb21 * n22)
             c22 = pc22 - p * (pb12 * n12 + pb22 * n22)
