@@ -1,5 +1,7 @@
 # rsmhp: replication pipeline for Ragi & Mittelmann (IEEE L-CSS 2021), RS-MHP vs NBO.
 # Thin entry point: load and validate the config, then include the rule files.
+import sys
+
 from snakemake.utils import min_version, update_config, validate
 
 from rsmhp.config import ConfigError, check_config, load_config_file, typed_overrides
@@ -22,7 +24,15 @@ os.environ.update(
 # A broken config/config.yaml is reported with its line (Snakemake only says "not valid
 # YAML"); files given with --configfile are parsed by Snakemake before this file runs:
 # `python -m rsmhp.config FILE` reports their lines.
-load_config_file(os.path.join(workflow.basedir, "config", "config.yaml"))
+def refuse(problem):
+    """Stop with the message alone: it names the file, key or rule; a traceback would bury it."""
+    sys.exit(str(problem))
+
+
+try:
+    load_config_file(os.path.join(workflow.basedir, "config", "config.yaml"))
+except ConfigError as exc:
+    refuse(exc)
 
 
 configfile: os.path.join(workflow.basedir, "config", "config.yaml")
@@ -32,9 +42,13 @@ configfile: os.path.join(workflow.basedir, "config", "config.yaml")
 update_config(config, typed_overrides(workflow.config_settings.config))
 
 # Friendly, complete error list first (names every field and its allowed range) ...
-check_config(
-    config, os.path.join(workflow.basedir, "workflow", "schemas", "config.schema.yaml")
-)
+try:
+    check_config(
+        config,
+        os.path.join(workflow.basedir, "workflow", "schemas", "config.schema.yaml"),
+    )
+except ConfigError as exc:
+    refuse(exc)
 
 
 # ... then snakemake's own validation, which also fills in defaults.
@@ -51,12 +65,11 @@ include: "workflow/rules/report.smk"
 
 # Memory: every simulation rule's estimate for this config within its mem_mb, before any job.
 _memory = memory_problems(
-    config, {r.name: getattr(r.resources.get("mem_mb"), "raw", None) for r in workflow.rules}
+    config,
+    {r.name: getattr(r.resources.get("mem_mb"), "raw", None) for r in workflow.rules},
 )
 if _memory:
-    raise ConfigError(
-        "invalid configuration (nothing was run):\n  - " + "\n  - ".join(_memory)
-    )
+    refuse("invalid configuration (nothing was run):\n  - " + "\n  - ".join(_memory))
 
 
 rule all:

@@ -203,10 +203,15 @@ def weighted_limit(
 
 
 def _coefficients(H: int, a: float) -> np.ndarray:
-    """:math:`c_k = (1-a)^{H-1-k}`, k = 0..H-1: weight of :math:`a u_k + w_k` in :math:`x_H`."""
-    H = guards.positive_int("H", H)
-    _check(a=a)
+    """:math:`c_k = (1-a)^{H-1-k}`, k = 0..H-1: weight of :math:`a u_k + w_k` in :math:`x_H`
+    (unchecked: the public callers check ``H`` and ``a`` once)."""
     return (1.0 - a) ** np.arange(H - 1, -1, -1, dtype=float)
+
+
+def _optimal(H: int, x0: float, a: float, r: float, target: float) -> np.ndarray:
+    """:func:`optimal_controls` without the argument checks."""
+    c = _coefficients(H, a)
+    return r * a * (target - (1.0 - a) ** H * x0) * c / (1.0 + r * a * a * np.dot(c, c))
 
 
 def optimal_controls(H: int, *, x0: float, a: float, r: float, target: float) -> np.ndarray:
@@ -214,9 +219,7 @@ def optimal_controls(H: int, *, x0: float, a: float, r: float, target: float) ->
     :math:`u^* = r a (T - b^H x_0)\, c / (1 + r a^2 |c|^2)`. NBO's cost has the same
     minimiser (it differs from J by the constant :math:`r v_H`)."""
     _check(a=a, r=r, x0=x0, target=target)
-    H = guards.positive_int("H", H)
-    c = _coefficients(H, a)
-    return r * a * (target - (1.0 - a) ** H * x0) * c / (1.0 + r * a * a * np.dot(c, c))
+    return _optimal(guards.positive_int("H", H), x0, a, r, target)
 
 
 def sample_argmin(
@@ -258,9 +261,10 @@ def regret(u: np.ndarray | list[float], *, x0: float, a: float, r: float, target
     r""":math:`J(u) - J(u^*) = (u - u^*)^\top (I + r a^2 c c^\top)(u - u^*) \ge 0` (exact
     quadratic form, free of the cancellation in a difference of two costs; independent of
     :math:`\sigma`)."""
+    _check(a=a, r=r, x0=x0, target=target)
     u = _u(u)
     c = _coefficients(u.size, a)
-    d = u - optimal_controls(u.size, x0=x0, a=a, r=r, target=target)
+    d = u - _optimal(u.size, x0, a, r, target)
     return float(np.dot(d, d) + r * a * a * np.dot(c, d) ** 2)
 
 
@@ -268,7 +272,7 @@ def regret_gain(H: int, *, a: float, r: float) -> float:
     r""":math:`\kappa = r^2 a^2 |c|^2 / (1 + r a^2 |c|^2)`: a sample-average argmin whose
     weighted mean final-state noise is :math:`\bar e` has regret :math:`\kappa\bar e^2`."""
     _check(a=a, r=r)
-    cc = float(np.dot(c := _coefficients(H, a), c))
+    cc = float(np.dot(c := _coefficients(guards.positive_int("H", H), a), c))
     return r * r * a * a * cc / (1.0 + r * a * a * cc)
 
 
