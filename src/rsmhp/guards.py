@@ -167,6 +167,16 @@ def real(
 
     Returned unchanged (a numpy scalar stays a numpy scalar).
     """
+    if (
+        type(value) is float
+        and value == value
+        and (  # fast path: a plain finite float in range
+            (lo is None or (value > lo if lo_open else value >= lo))
+            and (hi is None or (value < hi if hi_open else value <= hi))
+            and (not finite or abs(value) != math.inf)
+        )
+    ):
+        return value
     if isinstance(value, np.ndarray) and value.ndim == 0:
         value = value[()]
     if isinstance(value, bool | np.bool_) or not isinstance(

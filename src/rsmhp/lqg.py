@@ -300,10 +300,12 @@ class LQGModel:
         _check(a=self.a, sigma=self.sigma, r=self.r, target=self.target)
         if self.sigma == 0:
             raise ValueError("sigma must be > 0 for sampling (the noise density is undefined)")
+        # built (and checked, factorised) once: samplers ask for it at every tree and rollout
+        object.__setattr__(self, "_noise", GaussianNoise(self.sigma**2))
 
     @property
     def noise(self) -> GaussianNoise:
-        return GaussianNoise(self.sigma**2)
+        return self._noise
 
     def step(self, x: np.ndarray, u_k: float, w: np.ndarray) -> np.ndarray:
         """:math:`x_{k+1} = (1-a)x_k + a u_k + w_k`, shapes (n, 1)."""
