@@ -24,15 +24,11 @@ os.environ.update(
 # A broken config/config.yaml is reported with its line (Snakemake only says "not valid
 # YAML"); files given with --configfile are parsed by Snakemake before this file runs:
 # `python -m rsmhp.config FILE` reports their lines.
-def refuse(problem):
-    """Stop with the message alone: it names the file, key or rule; a traceback would bury it."""
-    sys.exit(str(problem))
-
-
+# A refusal prints its message alone (it names the file, key or rule; no Python frames).
 try:
     load_config_file(os.path.join(workflow.basedir, "config", "config.yaml"))
 except ConfigError as exc:
-    refuse(exc)
+    sys.exit(str(exc))
 
 
 configfile: os.path.join(workflow.basedir, "config", "config.yaml")
@@ -48,7 +44,7 @@ try:
         os.path.join(workflow.basedir, "workflow", "schemas", "config.schema.yaml"),
     )
 except ConfigError as exc:
-    refuse(exc)
+    sys.exit(str(exc))
 
 
 # ... then snakemake's own validation, which also fills in defaults.
@@ -69,7 +65,7 @@ _memory = memory_problems(
     {r.name: getattr(r.resources.get("mem_mb"), "raw", None) for r in workflow.rules},
 )
 if _memory:
-    refuse("invalid configuration (nothing was run):\n  - " + "\n  - ".join(_memory))
+    sys.exit("invalid configuration (nothing was run):\n  - " + "\n  - ".join(_memory))
 
 
 rule all:
