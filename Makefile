@@ -9,7 +9,19 @@ CORES ?= 2
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.rsmhp-installed
 
-.PHONY: replicate test lint setup clean
+.PHONY: help replicate test lint setup clean
+
+help:
+	@echo "rsmhp: replication pipeline (RS-MHP vs NBO). Targets:"
+	@echo "  make replicate [ARGS=...]  set up .venv if needed, run the full replication (snakemake -j$(CORES) ARGS)"
+	@echo "  make test                  set up, lint, run the test suite (what CI runs)"
+	@echo "  make setup                 create .venv, install rsmhp[dev], compile the planner kernels"
+	@echo "  make lint                  ruff, ruff format --check, snakefmt --check, snakemake --lint"
+	@echo "  make clean                 delete results/ and .snakemake/"
+	@echo "Variables: CORES=$(CORES) PYTHON=$(PYTHON) VENV=$(VENV)"
+	@echo "Check a config overlay:  $(BIN)/python -m rsmhp.config my.yaml"
+	@echo "Rules and targets (snakemake --list-rules):"
+	@test -x $(BIN)/snakemake && $(BIN)/snakemake --list-rules 2>/dev/null | sed 's/^/  /' || echo "  (run make setup first)"
 
 $(STAMP): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "rsmhp needs Python >= 3.11, found " + sys.version.split()[0])'

@@ -69,6 +69,7 @@ if _memory:
 
 
 rule all:
+    """Default target: the full replication and its report."""
     default_target: True
     input:
         rules.lqg.input,

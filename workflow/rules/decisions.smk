@@ -22,6 +22,7 @@ wildcard_constraints:
 
 
 rule decisions_lqg:
+    """Decision study, LQG: regret of every method's sample-average argmin (exact)."""
     output:
         "results/decisions/lqg_regret.csv",
     log:
@@ -43,6 +44,7 @@ rule decisions_lqg:
 
 
 rule decisions_lqg_summary:
+    """Decision study, LQG: per-cell regret, slopes vs closed forms, claims, tables."""
     input:
         "results/decisions/lqg_regret.csv",
     output:
@@ -70,6 +72,7 @@ rule decisions_lqg_summary:
 
 
 rule decisions_uav:
+    """Decision study, UAV open loop: every method plans at NBO belief states; plans scored on independent hypotheses."""
     output:
         "results/decisions/uav_regret.csv",
     log:
@@ -91,6 +94,7 @@ rule decisions_uav:
 
 
 rule decisions_map_cell:
+    """Decision study, UAV map: paired closed-loop runs and open-loop regret in map cell {cell}."""
     output:
         runs="results/decisions/map/{cell}.csv",
         regret="results/decisions/map/{cell}_regret.csv",
@@ -123,6 +127,7 @@ rule decisions_map_cell:
 
 
 rule decisions_uav_summary:
+    """Decision study, UAV: regret summary, sensitivity map, claims, tables, section."""
     input:
         regret="results/decisions/uav_regret.csv",
         map_runs=expand("results/decisions/map/{cell}.csv", cell=MAP_CELLS),
@@ -153,6 +158,7 @@ rule decisions_uav_summary:
 
 
 rule decisions_figures:
+    """Decision study figures: LQG regret, UAV regret, the map."""
     input:
         lqg="results/decisions/lqg_summary.csv",
         regret="results/decisions/uav_regret.csv",
@@ -176,6 +182,7 @@ rule decisions_figures:
 
 
 rule decisions_recording:
+    """Rerun recording of one footprint run: NBO and RS-MHP side by side."""
     output:
         DEC_RECORDING,
     log:
@@ -199,6 +206,7 @@ rule decisions_recording:
 
 
 rule decisions:
+    """Target: the whole decision-quality study."""
     input:
         rules.decisions_lqg.output,
         rules.decisions_lqg_summary.output,

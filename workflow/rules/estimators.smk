@@ -34,6 +34,7 @@ EST_SIM = pick(
 
 
 rule estimators_ablation:
+    """Estimator study simulation: every (problem, scheme, size) cell, replicated."""
     output:
         "results/estimators/ablation.csv",
     log:
@@ -55,6 +56,7 @@ rule estimators_ablation:
 
 
 rule estimators_summary:
+    """Estimator study aggregation: bias, variance, RMSE, slopes, claims, tables, section."""
     input:
         ablation="results/estimators/ablation.csv",
     output:
@@ -82,6 +84,7 @@ rule estimators_summary:
 
 
 rule estimators_figures:
+    """Estimator study figures."""
     input:
         summary="results/estimators/summary.csv",
     output:
@@ -104,6 +107,7 @@ rule estimators_figures:
 
 
 rule estimators_recording:
+    """Rerun recording of a tree of the estimator study."""
     output:
         "results/recordings/estimators_tree.rrd",
     log:
@@ -126,6 +130,7 @@ rule estimators_recording:
 
 
 rule estimators:
+    """Target: the whole estimator study."""
     input:
         rules.estimators_ablation.output,
         rules.estimators_summary.output,

@@ -15,6 +15,7 @@ LQG_SIM = {
 
 
 rule lqg_convergence:
+    """Fig. 3 simulation: MHP estimates (uniform and weighted) for every P of the grid, next to the NBO and exact costs."""
     output:
         "results/lqg/convergence.csv",
     log:
@@ -39,6 +40,7 @@ rule lqg_convergence:
 
 
 rule lqg_nbo_error:
+    """NBO error over the (a, H) grid: simulated J_P - J_NBO next to the closed form r sigma^2 sum (1-a)^{2n}."""
     output:
         "results/lqg/nbo_error.csv",
     log:
@@ -59,6 +61,7 @@ rule lqg_nbo_error:
 
 
 rule lqg_summary:
+    """LQG aggregation: per-P statistics, NBO-error summary, Markdown tables, report section."""
     input:
         convergence="results/lqg/convergence.csv",
         nbo_error="results/lqg/nbo_error.csv",
@@ -86,6 +89,7 @@ rule lqg_summary:
 
 
 rule lqg_figures:
+    """LQG figures: convergence (Fig. 3 analogue), error vs P on log-log axes, NBO error."""
     input:
         convergence="results/lqg/convergence.csv",
         summary="results/lqg/summary.csv",
@@ -110,6 +114,7 @@ rule lqg_figures:
 
 
 rule lqg_recording:
+    """Rerun recording of one sampled and pruned LQG trajectory tree."""
     output:
         "results/recordings/lqg_tree.rrd",
     log:
@@ -132,6 +137,7 @@ rule lqg_recording:
 
 
 rule lqg:
+    """Target: every LQG output."""
     input:
         rules.lqg_convergence.output,
         rules.lqg_nbo_error.output,

@@ -2,6 +2,7 @@
 
 
 rule report:
+    """The replication report paper/replication.md and its figures, from every section."""
     input:
         sections=list(REPORT_SECTIONS.values()),
         figures=expand("results/figures/{name}.png", name=REPORT_FIGURES),

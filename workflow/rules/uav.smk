@@ -27,6 +27,7 @@ wildcard_constraints:
 
 
 rule uav_simulate:
+    """UAV closed loop: one method, one chunk of Monte-Carlo runs (runs CSV + steps Parquet)."""
     output:
         runs="results/uav/chunks/{method}/{chunk}.csv",
         steps="results/uav/chunks/{method}/{chunk}.parquet",
@@ -52,6 +53,7 @@ rule uav_simulate:
 
 
 rule uav_collect:
+    """Check every UAV chunk against the config and concatenate them (runs.csv, steps.parquet)."""
     input:
         runs=expand(
             "results/uav/chunks/{method}/{chunk}.csv",
@@ -89,6 +91,7 @@ rule uav_collect:
 
 
 rule uav_summary:
+    """UAV aggregation: per-method errors, paired differences, claims, tables, section."""
     input:
         runs="results/uav/runs.csv",
     output:
@@ -117,6 +120,7 @@ rule uav_summary:
 
 
 rule uav_figures:
+    """UAV figures: error ECDFs (Figs. 4 and 5 analogues) and paired differences."""
     input:
         runs="results/uav/runs.csv",
         summary="results/uav/summary.csv",
@@ -142,6 +146,7 @@ rule uav_figures:
 
 
 rule uav_recording:
+    """Rerun recording of UAV run {k}, every method side by side."""
     output:
         "results/recordings/uav_run{k}.rrd",
     log:
@@ -164,6 +169,7 @@ rule uav_recording:
 
 
 rule uav:
+    """Target: every UAV output."""
     input:
         rules.uav_collect.output,
         rules.uav_summary.output,
