@@ -357,3 +357,24 @@ def test_slurm_profile_plans_every_rule(tmp_path):
     assert profile["executor"] == "slurm"
     block = out.split("rule estimators_ablation:", 1)[1].split("\n\n", 1)[0]
     assert "mem_mb=8000" in block and "runtime=60" in block
+
+
+def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, tmp_path):
+    """`snakemake --report report.html` on the tiny run: every figure (PNG) and table of the
+    pipeline is in it, each with the caption text of workflow/report/."""
+    html_path = tmp_path / "report.html"
+    res = snakemake(run_j2, "--report", str(html_path))
+    assert res.returncode == 0, (res.stdout + res.stderr)[-3000:]
+    assert "ERROR/" not in res.stdout + res.stderr  # every caption is valid reStructuredText
+    html = html_path.read_text(errors="replace")
+    captions = sorted((ROOT / "workflow/report").glob("*.rst"))
+    figures = [p.stem for p in (run_j2 / "results/figures").glob("*.png")]
+    tables = [p.stem for p in (run_j2 / "results/tables").glob("*.md")]
+    assert len(figures) == 15 and len(tables) == 14
+    assert {c.stem for c in captions} == set(figures) | {f"table_{t}" for t in tables}
+    for name in figures:
+        assert f"{name}.png" in html, name
+    for name in tables:
+        assert f"{name}.md" in html, name
+    for cap in captions:  # first words of each caption (the HTML escapes some characters)
+        assert " ".join(cap.read_text().split()[:4]) in html, cap.name

@@ -26,3 +26,35 @@ def canonical(value):
 def pick(mapping, *keys):
     """The sub-dict of ``mapping`` with just ``keys`` (key-sorted), for a rule's params."""
     return canonical({k: mapping[k] for k in keys})
+
+
+# Snakemake's report() flag; a line starting with "report" would parse as the report directive
+_in_report = report
+
+
+def figure_outputs(names, category):
+    """PNG and PDF of each figure; the PNGs go into the Snakemake report (``snakemake
+    --report report.html``), captioned by workflow/report/<name>.rst."""
+    pngs = [
+        _in_report(
+            f"results/figures/{n}.png",
+            caption=f"../report/{n}.rst",
+            category=category,
+            labels={"figure": n},
+        )
+        for n in names
+    ]
+    return pngs + expand("results/figures/{name}.pdf", name=names)
+
+
+def table_outputs(names, category):
+    """Markdown tables, in the Snakemake report with workflow/report/table_<name>.rst."""
+    return [
+        _in_report(
+            f"results/tables/{n}.md",
+            caption=f"../report/table_{n}.rst",
+            category=category,
+            labels={"table": n},
+        )
+        for n in names
+    ]

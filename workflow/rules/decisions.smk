@@ -50,9 +50,7 @@ rule decisions_lqg_summary:
     output:
         summary="results/decisions/lqg_summary.csv",
         scaling="results/decisions/lqg_scaling.csv",
-        tables=expand(
-            "results/tables/{name}.md", name=["dec_lqg_regret", "dec_lqg_scaling"]
-        ),
+        tables=table_outputs(["dec_lqg_regret", "dec_lqg_scaling"], "Decision study"),
         section="results/report/decisions_lqg.json",
     log:
         "results/logs/decisions_lqg_summary.log",
@@ -135,9 +133,7 @@ rule decisions_uav_summary:
     output:
         regret_summary="results/decisions/uav_regret_summary.csv",
         map="results/decisions/uav_map.csv",
-        tables=expand(
-            "results/tables/{name}.md", name=["dec_uav_regret", "dec_uav_map"]
-        ),
+        tables=table_outputs(["dec_uav_regret", "dec_uav_map"], "Decision study"),
         section="results/report/decisions_uav.json",
     log:
         "results/logs/decisions_uav_summary.log",
@@ -164,7 +160,7 @@ rule decisions_figures:
         regret="results/decisions/uav_regret.csv",
         map="results/decisions/uav_map.csv",
     output:
-        expand("results/figures/{name}.{ext}", name=DEC_FIGURES, ext=("png", "pdf")),
+        figure_outputs(DEC_FIGURES, "Decision study"),
     log:
         "results/logs/decisions_figures.log",
     benchmark:

@@ -61,7 +61,7 @@ rule estimators_summary:
         ablation="results/estimators/ablation.csv",
     output:
         summary="results/estimators/summary.csv",
-        tables=expand("results/tables/{name}.md", name=EST_TABLES),
+        tables=table_outputs(EST_TABLES, "Estimator study"),
         section="results/report/estimators.json",
     log:
         "results/logs/estimators_summary.log",
@@ -88,7 +88,7 @@ rule estimators_figures:
     input:
         summary="results/estimators/summary.csv",
     output:
-        expand("results/figures/{name}.{ext}", name=EST_FIGURES, ext=("png", "pdf")),
+        figure_outputs(EST_FIGURES, "Estimator study"),
     log:
         "results/logs/estimators_figures.log",
     benchmark:

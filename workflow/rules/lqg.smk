@@ -68,7 +68,7 @@ rule lqg_summary:
     output:
         summary="results/lqg/summary.csv",
         nbo_summary="results/lqg/nbo_error_summary.csv",
-        tables=expand("results/tables/{name}.md", name=LQG_TABLES),
+        tables=table_outputs(LQG_TABLES, "LQG"),
         section="results/report/lqg.json",
     log:
         "results/logs/lqg_summary.log",
@@ -95,7 +95,7 @@ rule lqg_figures:
         summary="results/lqg/summary.csv",
         nbo_summary="results/lqg/nbo_error_summary.csv",
     output:
-        expand("results/figures/{name}.{ext}", name=LQG_FIGURES, ext=("png", "pdf")),
+        figure_outputs(LQG_FIGURES, "LQG"),
     log:
         "results/logs/lqg_figures.log",
     benchmark:

@@ -97,7 +97,7 @@ rule uav_summary:
     output:
         summary="results/uav/summary.csv",
         paired="results/uav/paired.csv",
-        tables=expand("results/tables/{name}.{ext}", name=UAV_TABLES, ext=("md",)),
+        tables=table_outputs(UAV_TABLES, "UAV"),
         section="results/report/uav.json",
     log:
         "results/logs/uav_summary.log",
@@ -126,7 +126,7 @@ rule uav_figures:
         summary="results/uav/summary.csv",
         paired="results/uav/paired.csv",
     output:
-        expand("results/figures/{name}.{ext}", name=UAV_FIGURES, ext=("png", "pdf")),
+        figure_outputs(UAV_FIGURES, "UAV"),
     log:
         "results/logs/uav_figures.log",
     benchmark:
