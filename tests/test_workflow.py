@@ -119,6 +119,11 @@ def test_recording_and_report(run_j2, tiny):
     summary = pd.read_csv(run_j2 / "results/lqg/summary.csv")
     assert f"J = {summary['J_exact'].iloc[0]:.4f}" in report
     assert "seed: 7" in report  # the tiny config's seed, i.e. the parameters actually used
+    import json
+
+    prov = json.loads((run_j2 / "results/provenance.json").read_text())
+    assert {"commit", "config sha256", "blas", "cpu", "host", "date (UTC)"} <= prov.keys()
+    assert f"- config sha256: `{prov['config sha256']}`" in report and "- host:" not in report
     for link in ("figures/lqg_convergence.png", "figures/lqg_error_loglog.png"):
         assert f"]({link})" in report and (run_j2 / "paper" / link).exists()
 

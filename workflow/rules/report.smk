@@ -9,6 +9,7 @@ rule report:
     output:
         report="paper/replication.md",
         figures=expand("paper/figures/{name}.png", name=REPORT_FIGURES),
+        provenance="results/provenance.json",
     log:
         "results/logs/report.log",
     benchmark:
