@@ -223,10 +223,13 @@ def provenance(
 
     root = Path(root) if root is not None else Path(__file__).resolve().parents[2]
     commit = _git(root, "rev-parse", "HEAD")
-    status = _git(root, "status", "--porcelain", "--untracked-files=no")
+    # paper/ holds the report's own outputs (Snakemake removes them while the rule runs)
+    status = _git(root, "status", "--porcelain", "--untracked-files=no", "--", ".", ":!paper")
     out = {
         "commit": commit or "unknown (not a git checkout)",
-        "uncommitted changes": "unknown" if status is None else ("yes" if status else "no"),
+        "uncommitted changes (outside paper/)": "unknown"
+        if status is None
+        else ("yes" if status else "no"),
     }
     if config is not None:
         canon = json.dumps(config, sort_keys=True, default=str).encode()
