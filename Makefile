@@ -9,11 +9,12 @@ CORES ?= 2
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.rsmhp-installed
 
-.PHONY: help replicate test lint setup clean
+.PHONY: help replicate publish test lint setup clean
 
 help:
 	@echo "rsmhp: replication pipeline (RS-MHP vs NBO). Targets:"
 	@echo "  make replicate [ARGS=...]  set up .venv if needed, run the full replication (snakemake -j$(CORES) ARGS)"
+	@echo "  make publish               update the tracked paper/ from results/paper/ (runs what is missing)"
 	@echo "  make test                  set up, lint, run the test suite (what CI runs)"
 	@echo "  make setup                 create .venv, install rsmhp[dev], compile the planner kernels"
 	@echo "  make lint                  ruff, ruff format --check, snakefmt --check, snakemake --lint"
@@ -37,6 +38,14 @@ setup: $(STAMP)
 # extra snakemake flags: make replicate ARGS="--rerun-incomplete"
 replicate: $(STAMP)
 	$(BIN)/snakemake -j$(CORES) $(ARGS)
+
+# copy the report of results/ into the tracked paper/ (the only target that changes tracked files)
+publish: $(STAMP)
+	$(BIN)/snakemake -j$(CORES) report $(ARGS)
+	rm -rf paper/figures
+	mkdir -p paper/figures
+	cp results/paper/replication.md paper/replication.md
+	cp results/paper/figures/*.png paper/figures/
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

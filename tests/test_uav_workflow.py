@@ -62,8 +62,8 @@ def test_uav_summary_tables_figures_report(run_j2, tiny):
         png = (run_j2 / f"results/figures/{name}.png").read_bytes()
         assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
         assert (run_j2 / f"results/figures/{name}.pdf").read_bytes()[:5] == b"%PDF-"
-        assert (run_j2 / f"paper/figures/{name}.png").read_bytes() == png
-    report = (run_j2 / "paper/replication.md").read_text()
+        assert (run_j2 / f"results/paper/figures/{name}.png").read_bytes() == png
+    report = (run_j2 / "results/paper/replication.md").read_text()
     for cid in ("UAV-1", "UAV-2", "UAV-3"):
         assert f"| {cid} |" in report
     assert "## Case study 2: UAV target tracking" in report

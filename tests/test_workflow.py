@@ -50,7 +50,6 @@ def snakemake(
 
 def digest(workdir: Path) -> dict[str, str]:
     files = [p for p in sorted((workdir / "results").rglob("*")) if p.is_file()]
-    files += [p for p in sorted((workdir / "paper").rglob("*")) if p.is_file()]
     return {str(p.relative_to(workdir)): hashlib.sha256(p.read_bytes()).hexdigest() for p in files}
 
 
@@ -100,7 +99,7 @@ def test_outputs_content(run_j2, tiny):
         png = (run_j2 / f"results/figures/{name}.png").read_bytes()
         assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
         assert (run_j2 / f"results/figures/{name}.pdf").read_bytes()[:5] == b"%PDF-"
-        assert (run_j2 / f"paper/figures/{name}.png").read_bytes() == png
+        assert (run_j2 / f"results/paper/figures/{name}.png").read_bytes() == png
     for rule in ("lqg_convergence", "lqg_nbo_error", "lqg_summary", "lqg_figures", "report"):
         assert (run_j2 / f"results/benchmarks/{rule}.tsv").exists()
         assert "done in" in (run_j2 / f"results/logs/{rule}.log").read_text()
@@ -113,7 +112,7 @@ def test_recording_and_report(run_j2, tiny):
         counts[chunk.entity_path] = counts.get(chunk.entity_path, 0) + chunk.num_rows
     for k in range(1, len(rec["u"]) + 1):
         assert f"/tree/level_{k}/kept" in counts
-    report = (run_j2 / "paper/replication.md").read_text()
+    report = (run_j2 / "results/paper/replication.md").read_text()
     for cid in ("LQG-1", "LQG-2", "LQG-3", "LQG-4"):
         assert f"| {cid} |" in report
     summary = pd.read_csv(run_j2 / "results/lqg/summary.csv")
@@ -125,7 +124,7 @@ def test_recording_and_report(run_j2, tiny):
     assert {"commit", "config sha256", "blas", "cpu", "host", "date (UTC)"} <= prov.keys()
     assert f"- config sha256: `{prov['config sha256']}`" in report and "- host:" not in report
     for link in ("figures/lqg_convergence.png", "figures/lqg_error_loglog.png"):
-        assert f"]({link})" in report and (run_j2 / "paper" / link).exists()
+        assert f"]({link})" in report and (run_j2 / "results/paper" / link).exists()
 
 
 def test_j1_and_j2_give_identical_results(run_j2, tmp_path):
@@ -141,7 +140,7 @@ def test_j1_and_j2_give_identical_results(run_j2, tmp_path):
         a = pd.read_csv(tmp_path / rel).drop(columns=timing)
         b = pd.read_csv(run_j2 / rel).drop(columns=timing)
         assert a.to_csv(index=False) == b.to_csv(index=False), rel
-    assert not (tmp_path / "paper").exists()  # named targets do not build the report
+    assert not (tmp_path / "results/paper").exists()  # named targets do not build the report
 
 
 def test_estimator_study_outputs(run_j2, tiny):
@@ -173,8 +172,8 @@ def test_estimator_study_outputs(run_j2, tiny):
         "est_frontier",
     ):
         assert (run_j2 / f"results/figures/{name}.png").read_bytes()[:4] == b"\x89PNG"
-        assert (run_j2 / f"paper/figures/{name}.png").exists()
-    report = (run_j2 / "paper/replication.md").read_text()
+        assert (run_j2 / f"results/paper/figures/{name}.png").exists()
+    report = (run_j2 / "results/paper/replication.md").read_text()
     for cid in ("EST-1", "EST-2", "EST-3", "EST-4"):
         assert f"| {cid} |" in report
     # sections in report order: LQG (10) before the estimator study (15)
@@ -265,11 +264,11 @@ def test_decision_study_outputs(run_j2, tiny, tmp_path):
     )
     assert (df["regret"] >= 0).all()
     assert df.loc[df.method == "nbo", "regret"].max() < 1e-12
-    report = (run_j2 / "paper/replication.md").read_text()
+    report = (run_j2 / "results/paper/replication.md").read_text()
     for cid in ("DEC-1", "DEC-2", "DEC-3"):
         assert f"| {cid} |" in report
     assert "](figures/dec_lqg_regret.png)" in report
-    assert (run_j2 / "paper/figures/dec_lqg_regret.png").exists()
+    assert (run_j2 / "results/paper/figures/dec_lqg_regret.png").exists()
     # one worker gives the same file (seeds keyed on the cell and replicate, not the worker)
     res = snakemake(tmp_path, "-j1", "results/decisions/lqg_regret.csv")
     assert res.returncode == 0, res.stderr[-3000:]
@@ -293,11 +292,11 @@ def test_uav_decision_outputs(run_j2, tiny):
         runs = pd.read_csv(run_j2 / f"results/decisions/map/{cell}.csv")
         assert len(runs) == cfg["map"]["runs"] * 2
         assert (run_j2 / f"results/benchmarks/decisions_map_cell/{cell}.tsv").exists()
-    report = (run_j2 / "paper/replication.md").read_text()
+    report = (run_j2 / "results/paper/replication.md").read_text()
     for cid in ("DEC-6", "DEC-8a", "DEC-8b"):
         assert f"| {cid} |" in report
     for name in ("dec_uav_regret", "dec_uav_map"):
-        assert (run_j2 / f"paper/figures/{name}.png").exists()
+        assert (run_j2 / f"results/paper/figures/{name}.png").exists()
 
 
 def test_killed_run_resumes_to_identical_results(run_j2, tmp_path):
@@ -383,3 +382,11 @@ def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, 
         assert f"{name}.md" in html, name
     for cap in captions:  # first words of each caption (the HTML escapes some characters)
         assert " ".join(cap.read_text().split()[:4]) in html, cap.name
+
+
+def test_a_run_writes_only_under_results(run_j2):
+    """A replication never rewrites tracked files: everything it writes is under results/
+    (the report included, results/paper/); `make publish` alone updates paper/."""
+    written = {p.name for p in run_j2.iterdir()} - {".snakemake"}
+    assert written == {"results"}, written
+    assert (run_j2 / "results/paper/replication.md").exists()

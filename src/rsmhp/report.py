@@ -3,7 +3,8 @@
 Each aggregation rule writes a :class:`Section` as JSON (``results/report/<key>.json``): its
 Markdown body (tables inline, figures referenced as ``figures/<name>.png``) and its
 :class:`Claim` s. The ``report`` rule renders every section, in ``order``, into
-``paper/replication.md`` and copies the referenced figures to ``paper/figures/``. A new
+``results/paper/replication.md`` and copies the referenced figures to ``results/paper/figures/``
+(``make publish`` copies both to the tracked ``paper/``). A new
 experiment family adds a section file and one entry to the report rule's inputs; nothing
 else changes.
 """
@@ -223,7 +224,7 @@ def provenance(
 
     root = Path(root) if root is not None else Path(__file__).resolve().parents[2]
     commit = _git(root, "rev-parse", "HEAD")
-    # paper/ holds the report's own outputs (Snakemake removes them while the rule runs)
+    # paper/ holds the published copy of the report (`make publish` rewrites it)
     status = _git(root, "status", "--porcelain", "--untracked-files=no", "--", ".", ":!paper")
     out = {
         "commit": commit or "unknown (not a git checkout)",

@@ -1,14 +1,15 @@
-# The replication report: paper/replication.md plus the figures it shows.
+# The replication report: results/paper/replication.md plus the figures it shows.
+# `make publish` copies it to paper/ (tracked); a replication never touches tracked files.
 
 
 rule report:
-    """The replication report paper/replication.md and its figures, from every section."""
+    """The replication report results/paper/replication.md and its figures, from every section."""
     input:
         sections=list(REPORT_SECTIONS.values()),
         figures=expand("results/figures/{name}.png", name=REPORT_FIGURES),
     output:
-        report="paper/replication.md",
-        figures=expand("paper/figures/{name}.png", name=REPORT_FIGURES),
+        report="results/paper/replication.md",
+        figures=expand("results/paper/figures/{name}.png", name=REPORT_FIGURES),
         provenance="results/provenance.json",
     log:
         "results/logs/report.log",

@@ -1,5 +1,5 @@
-"""Rule report: render paper/replication.md from the report sections, copy its figures, write
-results/provenance.json."""
+"""Rule report: render results/paper/replication.md from the report sections, copy its
+figures, write results/provenance.json."""
 
 import json
 import shutil
