@@ -81,14 +81,12 @@ def load_config_file(path: str | os.PathLike) -> dict[str, Any]:
 
 
 def merge(base: Mapping[str, Any], overlay: Mapping[str, Any]) -> dict[str, Any]:
-    """Snakemake's overlay rule: mappings merge key by key, anything else (lists included)
-    replaces the base value."""
+    """Snakemake's overlay rule (``snakemake.utils.update_config``) on copies: mappings merge
+    key by key, anything else (lists included) replaces the base value."""
+    from snakemake.utils import update_config  # the rule itself, on copies
+
     out = copy.deepcopy(dict(base))
-    for key, value in overlay.items():
-        if isinstance(value, Mapping) and isinstance(out.get(key), Mapping):
-            out[key] = merge(out[key], value)
-        else:
-            out[key] = copy.deepcopy(value)
+    update_config(out, copy.deepcopy(dict(overlay)))
     return out
 
 

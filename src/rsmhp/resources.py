@@ -29,8 +29,6 @@ __all__ = ["BASE_MB", "WORKER_MB", "estimate_mb", "memory_problems", "working_se
 BASE_MB = 300
 FIXED_BYTES = 1 << 24
 WORKER_MB = 200
-#: leaves of one batch of replicate trees (mirrors rsmhp.experiments.estimators._BATCH_LEAVES)
-_BATCH_LEAVES = 1 << 20
 
 
 def working_set_bytes(P: int, H: int, n: int = 1) -> int:
@@ -77,7 +75,8 @@ def _lqg_cells(config: Mapping[str, Any]) -> dict[str, tuple[int, str]]:
         leaves = estimators._n_trajectories(pt, prob)
         if pt.scheme in ("tree", "tree_pernode"):
             # replicate trees of row-wise problems are sampled in batches of <= 2^20 leaves
-            per = min(reps, max(1, _BATCH_LEAVES // leaves)) if prob.noise.rowwise else 1
+            batch = estimators._BATCH_LEAVES
+            per = min(reps, max(1, batch // leaves)) if prob.noise.rowwise else 1
             P = per * leaves
         elif pt.scheme == "pruned":
             P = pt.M * pt.N  # every kept node's N children exist before pruning
