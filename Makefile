@@ -9,12 +9,13 @@ CORES ?= 2
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.rsmhp-installed
 
-.PHONY: help replicate publish test lint setup clean
+.PHONY: help replicate publish verify test lint setup clean
 
 help:
 	@echo "rsmhp: replication pipeline (RS-MHP vs NBO). Targets:"
 	@echo "  make replicate [ARGS=...]  set up .venv if needed, run the full replication (snakemake -j$(CORES) ARGS)"
-	@echo "  make publish               update the tracked paper/ from results/paper/ (runs what is missing)"
+	@echo "  make verify [ARGS=...]     run what is missing, compare every claim with paper/claims.json"
+	@echo "  make publish               update the tracked paper/ and README results from results/paper/"
 	@echo "  make test                  set up, lint, run the test suite (what CI runs)"
 	@echo "  make setup                 create .venv, install rsmhp[dev], compile the planner kernels"
 	@echo "  make lint                  ruff, ruff format --check, snakefmt --check, snakemake --lint"
@@ -40,12 +41,19 @@ replicate: $(STAMP)
 	$(BIN)/snakemake -j$(CORES) $(ARGS)
 
 # copy the report of results/ into the tracked paper/ (the only target that changes tracked files)
+# copy the report, its claims (the reference of make verify) and the README's glance table
 publish: $(STAMP)
 	$(BIN)/snakemake -j$(CORES) report $(ARGS)
 	rm -rf paper/figures
 	mkdir -p paper/figures
-	cp results/paper/replication.md paper/replication.md
+	cp results/paper/replication.md results/paper/appendix.md results/paper/claims.json paper/
 	cp results/paper/figures/*.png paper/figures/
+	$(BIN)/python -m rsmhp.report splice README.md results/paper/glance.md
+
+# compare a run with the committed reference paper/claims.json, claim by claim (runs what is
+# missing first); fails if a verdict flips or a key number leaves its tolerance
+verify: $(STAMP)
+	$(BIN)/snakemake -j$(CORES) verify $(ARGS)
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

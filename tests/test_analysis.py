@@ -10,7 +10,6 @@ from rsmhp import lqg
 from rsmhp.analysis import lqg as analysis
 from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, run_convergence, run_nbo_error
 from rsmhp.io import IntermediateFileError, read_table, write_csv
-from rsmhp.report import Claim, Section, render_report
 from rsmhp.stats import binomial_ci, loglog_slope, mean_ci, rmse_ci
 
 from .conftest import PAPER, PAPER_U
@@ -89,34 +88,6 @@ def test_nbo_error_claim_rejects_a_wrong_formula():
     wrong = nbo.assign(nbo_error_closed=nbo["nbo_error_closed"] * 1.5)
     wrong = wrong.assign(z=(wrong["nbo_error_sim"] - wrong["nbo_error_closed"]) / wrong["se"])
     assert analysis.nbo_error_claim(wrong, summary, conv).verdict == "not supported"
-
-
-def test_section_roundtrip_and_report(tmp_path):
-    conv = run_convergence(BASE, seed=2)
-    nbo = analysis.summarize_nbo_error(run_nbo_error(BASE, seed=2))
-    summary = analysis.summarize_convergence(conv, [1.0, 2.0])
-    tables = analysis.lqg_tables(summary, nbo, [1.0, 2.0])
-    section = analysis.lqg_section(summary, nbo, conv, [1.0, 2.0], tables)
-    section.save(tmp_path / "lqg.json")
-    loaded = Section.load(tmp_path / "lqg.json")
-    assert loaded == section
-    other = Section(
-        key="zzz",
-        title="Later study",
-        order=5,
-        body="text",
-        claims=[Claim("X-1", "c", "s", "e", "m", "inconclusive")],
-    )
-    text = render_report([loaded, other], {"seed": 2}, {"numpy": "x"})
-    assert text.index("## Later study") < text.index("## Case study 1")
-    for c in [*section.claims, *other.claims]:
-        assert f"| {c.id} |" in text
-    assert "5 claims: " in text and "seed: 2" in text
-    (tmp_path / "bad.json").write_text("{not json")
-    with pytest.raises(ValueError, match="not a valid report section"):
-        Section.load(tmp_path / "bad.json")
-    with pytest.raises(ValueError, match="verdict"):
-        Claim("X", "c", "s", "e", "m", "probably")
 
 
 def test_read_table_reports_corrupt_files(tmp_path):

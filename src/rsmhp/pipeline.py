@@ -19,7 +19,8 @@ def rule_logging(log_path: str | os.PathLike, rule: str) -> Iterator[logging.Log
 
     An *expected* failure (a corrupt or incomplete intermediate,
     :class:`rsmhp.io.IntermediateFileError`; an invalid configuration,
-    :class:`rsmhp.config.ConfigError`) is logged as its message alone and ends the script with
+    :class:`rsmhp.config.ConfigError`; a run that disagrees with the committed reference,
+    :class:`rsmhp.verify.VerificationError`) is logged as its message alone and ends the script with
     exit status 1: the message names the file or key and what to do, a traceback would only
     bury it. Any other exception is logged with its traceback and re-raised (a bug). Either
     way Snakemake marks the job failed (and removes its outputs; they are written atomically,
@@ -27,6 +28,7 @@ def rule_logging(log_path: str | os.PathLike, rule: str) -> Iterator[logging.Log
     """
     from rsmhp.config import ConfigError
     from rsmhp.io import IntermediateFileError
+    from rsmhp.verify import VerificationError
 
     Path(log_path).parent.mkdir(parents=True, exist_ok=True)
     handlers = [
@@ -44,7 +46,7 @@ def rule_logging(log_path: str | os.PathLike, rule: str) -> Iterator[logging.Log
     log.info("start")
     try:
         yield log
-    except (IntermediateFileError, ConfigError) as exc:
+    except (IntermediateFileError, ConfigError, VerificationError) as exc:
         log.error("failed: %s", exc)
         raise SystemExit(1) from None
     except Exception:

@@ -1,14 +1,19 @@
-# The replication report: results/paper/replication.md plus the figures it shows.
-# `make publish` copies it to paper/ (tracked); a replication never touches tracked files.
+# The replication report: results/paper/replication.md (main text), appendix.md, the figures
+# they show, the claims with their key numbers (claims.json) and the README's glance table.
+# `make publish` copies them to paper/ and README.md (tracked); a replication never touches
+# tracked files. `make verify` (rule verify) compares claims.json with paper/claims.json.
 
 
 rule report:
-    """The replication report results/paper/replication.md and its figures, from every section."""
+    """The replication report (main text, appendix, figures, claims) from every section."""
     input:
         sections=list(REPORT_SECTIONS.values()),
         figures=expand("results/figures/{name}.png", name=REPORT_FIGURES),
     output:
         report="results/paper/replication.md",
+        appendix="results/paper/appendix.md",
+        claims="results/paper/claims.json",
+        glance="results/paper/glance.md",
         figures=expand("results/paper/figures/{name}.png", name=REPORT_FIGURES),
         provenance="results/provenance.json",
     log:
@@ -25,3 +30,23 @@ rule report:
         config=canonical(config),
     script:
         "../scripts/report.py"
+
+
+rule verify:
+    """Compare this run's claims, claim by claim, with the committed reference paper/claims.json;
+    fails if a verdict flips or a key number leaves its tolerance."""
+    input:
+        run="results/paper/claims.json",
+        reference="paper/claims.json",
+    output:
+        "results/verify.md",
+    log:
+        "results/logs/verify.log",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=500,
+        runtime=5,
+    script:
+        "../scripts/verify.py"

@@ -1,5 +1,6 @@
-"""Rule report: render results/paper/replication.md from the report sections, copy its
-figures, write results/provenance.json."""
+"""Rule report: render results/paper/replication.md (main text) and appendix.md from the
+report sections, copy their figures, write the claims (claims.json, the README's glance
+table) and results/provenance.json."""
 
 import json
 import shutil
@@ -7,9 +8,16 @@ from pathlib import Path
 
 from rsmhp.io import write_text
 from rsmhp.pipeline import rule_logging
-from rsmhp.report import Section, provenance, render_report
+from rsmhp.report import (
+    Section,
+    claims_records,
+    glance_table,
+    provenance,
+    render_appendix,
+    render_report,
+)
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake.log[0], snakemake.rule) as log:
     sections = [Section.load(p) for p in snakemake.input.sections]
     for src, dst in zip(snakemake.input.figures, snakemake.output.figures, strict=True):
         Path(dst).parent.mkdir(parents=True, exist_ok=True)
@@ -18,5 +26,16 @@ with rule_logging(snakemake.log[0], snakemake.rule):
     write_text(json.dumps(prov, indent=1) + "\n", snakemake.output.provenance)
     # the report summarises it; host and date stay in the JSON (they change every run)
     summary = {k: v for k, v in prov.items() if k not in ("host", "date (UTC)")}
-    text = render_report(sections, snakemake.params.config, summary)
-    Path(snakemake.output.report).write_text(text, encoding="utf-8")
+    main = render_report(sections, summary)
+    write_text(main, snakemake.output.report)
+    write_text(render_appendix(sections, snakemake.params.config, summary), snakemake.output.appendix)
+    records = claims_records(sections)
+    claims_file = {
+        "config sha256": prov.get("config sha256"),
+        "commit": prov.get("commit"),
+        "claims": records,
+    }
+    write_text(json.dumps(claims_file, indent=1, ensure_ascii=False) + "\n", snakemake.output.claims)
+    claims = [c for s in sorted(sections, key=lambda s: (s.order, s.key)) for c in s.claims]
+    write_text(glance_table(claims) + "\n", snakemake.output.glance)
+    log.info("main text %d bytes, %d claims", len(main.encode()), len(records))
