@@ -25,7 +25,9 @@ Stages of the pipeline (one module per model and stage)
   analysis          lqg, estimators, uav, decisions: tables -> summaries, claims, sections
   figures           lqg, estimators, uav, decisions: seaborn figures (PNG + PDF)
   recording         rerun recordings of sampled trajectory trees
-  report            the claims ledger and report assembly
+  report            claims (key number, CI, verdict rule), the ledger, main text and appendix
+  verify            a run's claims against the committed reference (``make verify``)
+  palette           one colour and label per method, for every figure and recording
 Workflow support
   config            config files and schema checks (``python -m rsmhp.config FILE``)
   resources         memory estimate of each simulation rule from the config

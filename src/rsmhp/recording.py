@@ -3,10 +3,11 @@
 Layout of a tree recording (timeline ``step``, one tick per tree level):
 
 * ``tree/level_<k>/kept``    LineStrips2D: edges (k-1, x_parent) -> (k, x_child) that survived
-  pruning (green); every level is its own entity so earlier levels stay visible
-* ``tree/level_<k>/pruned``  LineStrips2D: edges dropped by pruning (thin, grey-red)
+  pruning (orange, the pruned tree's colour of :mod:`rsmhp.palette`); every level is its own
+  entity so earlier levels stay visible
+* ``tree/level_<k>/pruned``  LineStrips2D: edges dropped by pruning (thin, grey)
 * ``tree/level_<k>/nodes``   Points2D: children; radius and colour (viridis, bright = likely)
-  encode the trajectory likeliness within the level; pruned nodes are drawn red
+  encode the trajectory likeliness within the level; pruned nodes are drawn grey
 * ``pruning``                TextLog: per level, children, kept, and the likeliness cut-off
 * ``estimate/uniform``, ``estimate/weighted``  Scalars: running estimate of J after level k
 * ``estimate/exact``, ``estimate/nbo``  Scalars: the closed-form references
@@ -30,14 +31,24 @@ import rerun.blueprint as rrb
 from rsmhp import lqg
 from rsmhp.estimators import likeliness_weights
 from rsmhp.experiments.lqg import LQGParams
+from rsmhp.palette import method_rgb
 from rsmhp.sampling import sample_tree
 from rsmhp.seeding import canonical_job_id, job_rng
 
 __all__ = ["record_lqg_tree", "tree_blueprint"]
 
-KEPT = (40, 170, 60)
-PRUNED = (200, 90, 90, 140)
-ROOT = (30, 30, 30)
+#: kept edges in the pruned tree's method colour (rsmhp.palette, as in every figure); dropped
+#: edges and nodes grey; the running estimates: pruned tree (uniform), a lighter shade of it
+#: (weighted), NBO in its method colour, the exact J light grey (the viewer is dark)
+KEPT = method_rgb("pruned")
+PRUNED = (150, 150, 150, 120)
+ROOT = (230, 230, 230)
+SERIES = {
+    "exact": (230, 230, 230),
+    "nbo": method_rgb("nbo"),
+    "uniform": method_rgb("pruned"),
+    "weighted": (240, 196, 120),
+}
 
 
 def tree_blueprint() -> rrb.Blueprint:
@@ -117,13 +128,19 @@ def record_lqg_tree(
         f"x0={params.x0:g}, u={np.array2string(u, precision=3)}\n\n"
         f"N={n_branch} draws per step (shared by all nodes of a level), H={horizon}, "
         f"pruned to M={max_keep} most likely trajectories.\n\n"
-        "Green: kept branches; red: pruned. Node radius and colour (viridis, bright = likely): "
-        "trajectory likeliness within its level; the `pruning` log states each cut. "
+        "Orange (the pruned tree's colour in every figure): kept branches; grey: pruned. "
+        "Node radius and colour (viridis, bright = likely): trajectory likeliness within its "
+        "level; the `pruning` log states each cut. Estimates: pruned tree uniform (orange), "
+        "weighted (light orange), NBO (vermilion), exact J (light grey). "
         "Scrub the `step` timeline to grow the tree."
     )
     log("description", rr.TextDocument(text, media_type="text/markdown"), static=True)
     for name in ("exact", "nbo", "uniform", "weighted"):
-        log(f"estimate/{name}", rr.SeriesLines(names=name, widths=1.5), static=True)
+        log(
+            f"estimate/{name}",
+            rr.SeriesLines(names=name, widths=1.5, colors=[SERIES[name]]),
+            static=True,
+        )
     rec.set_time("step", sequence=0)
     log("tree/level_0/nodes", rr.Points2D([[0.0, params.x0]], radii=0.08, colors=[ROOT]))
     kept_x = np.array([params.x0])

@@ -1,0 +1,51 @@
+"""One colour per method (rsmhp.palette), shared by figures and recordings."""
+
+import pytest
+
+from rsmhp import recording
+from rsmhp.palette import METHOD_COLOURS, method_colour, method_label, method_rgb
+
+#: every method name that appears in a results table of the pipeline
+PIPELINE_METHODS = [
+    "nbo", "mc", "tree", "tree_pernode", "pruned", "antithetic", "sobol", "cubature",
+    "gauss_hermite", "rsmhp_nt10", "rsmhp_nt50", "rsmhp_nt100", "rsmhp_nt250", "tree_n8_m100",
+]  # fmt: skip
+
+
+def _luminance(hex_colour: str) -> float:
+    r, g, b = (int(hex_colour[i : i + 2], 16) / 255 for i in (1, 3, 5))
+    return 0.2126 * r + 0.7152 * g + 0.0722 * b
+
+
+def test_every_pipeline_method_has_a_colour_and_a_label():
+    for m in PIPELINE_METHODS:
+        assert method_colour(m).startswith("#") and len(method_colour(m)) == 7
+        assert method_label(m)
+    # method families are told apart: distinct colours
+    families = [c for k, c in METHOD_COLOURS.items() if k != "rsmhp"]
+    assert len(set(families)) == len(families)
+    assert method_colour("tree_n8_m100") == method_colour("pruned")
+    assert method_colour("rsmhp_nt100") == method_colour("mc")
+    assert method_label("rsmhp_nt250") == "RS-MHP N_T=250"
+    assert method_label("tree_n8_m100") == "pruned tree N=8 M=100"
+
+
+def test_rsmhp_shades_get_darker_with_n_t_and_do_not_depend_on_the_figure():
+    lum = [_luminance(method_colour(f"rsmhp_nt{n}")) for n in (10, 50, 100, 250, 1000)]
+    assert lum == sorted(lum, reverse=True) and len(set(lum)) == len(lum)
+    assert method_colour("RSMHP_NT50") == method_colour("rsmhp_nt50")
+
+
+def test_unknown_methods_are_refused_by_name():
+    with pytest.raises(ValueError, match="'magic'"):
+        method_colour("magic")
+    with pytest.raises(ValueError, match="'magic'"):
+        method_label("magic")
+
+
+def test_recordings_use_the_figure_colours():
+    h = method_colour("nbo").lstrip("#")
+    assert method_rgb("nbo") == tuple(int(h[i : i + 2], 16) for i in (0, 2, 4))
+    assert recording.KEPT == method_rgb("pruned")
+    assert recording.SERIES["nbo"] == method_rgb("nbo")
+    assert recording.SERIES["uniform"] == method_rgb("pruned")
