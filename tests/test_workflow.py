@@ -6,6 +6,9 @@ The full tiny run (``run_j2``, shared with tests/test_uav_workflow.py) is in con
 from __future__ import annotations
 
 import hashlib
+import json
+import re
+import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -113,18 +116,55 @@ def test_recording_and_report(run_j2, tiny):
     for k in range(1, len(rec["u"]) + 1):
         assert f"/tree/level_{k}/kept" in counts
     report = (run_j2 / "results/paper/replication.md").read_text()
+    appendix = (run_j2 / "results/paper/appendix.md").read_text()
+    claims = json.loads((run_j2 / "results/paper/claims.json").read_text())
+    by_id = {c["id"]: c for c in claims["claims"]}
     for cid in ("LQG-1", "LQG-2", "LQG-3", "LQG-4"):
-        assert f"| {cid} |" in report
-    summary = pd.read_csv(run_j2 / "results/lqg/summary.csv")
-    assert f"J = {summary['J_exact'].iloc[0]:.4f}" in report
-    assert "seed: 7" in report  # the tiny config's seed, i.e. the parameters actually used
-    import json
-
+        assert f"| {cid} |" in report and f"### {cid} ({by_id[cid]['verdict']})" in appendix
+        assert by_id[cid]["key"]["reproducible"] == "bitwise"
+    glance = (run_j2 / "results/paper/glance.md").read_text()
+    assert [line.split(" | ")[0][2:] for line in glance.splitlines()[2:]] == list(by_id)
+    assert "seed: 7" in appendix  # the tiny config's seed, i.e. the parameters actually used
     prov = json.loads((run_j2 / "results/provenance.json").read_text())
     assert {"commit", "config sha256", "blas", "cpu", "host", "date (UTC)"} <= prov.keys()
-    assert f"- config sha256: `{prov['config sha256']}`" in report and "- host:" not in report
+    assert claims["config sha256"] == prov["config sha256"] and claims["commit"] == prov["commit"]
+    assert f"config sha256 `{prov['config sha256']}`" in report
+    assert f"- config sha256: `{prov['config sha256']}`" in appendix and "- host:" not in appendix
     for link in ("figures/lqg_convergence.png", "figures/lqg_error_loglog.png"):
         assert f"]({link})" in report and (run_j2 / "results/paper" / link).exists()
+    for text in (report, appendix):
+        assert not re.search(r"\b(nan|inf)\b", text, flags=re.IGNORECASE)
+
+
+def test_verify_compares_a_run_with_the_reference(run_j2, tmp_path):
+    """`snakemake verify`: the run against itself passes; a flipped verdict or a reference of
+    another configuration fails with a message and no traceback, and writes no result."""
+    wd = tmp_path / "wd"
+    shutil.copytree(run_j2, wd, symlinks=True)
+    (wd / "paper").mkdir()
+    ref = wd / "paper/claims.json"
+    shutil.copyfile(wd / "results/paper/claims.json", ref)
+    res = snakemake(wd, "-j1", "verify")
+    assert res.returncode == 0, res.stderr[-3000:]
+    out = (wd / "results/verify.md").read_text()
+    assert out.startswith("# verify: PASS")
+    n = len(json.loads(ref.read_text())["claims"])
+    assert f"{n} of {n} claims agree" in out
+    assert "rule report" not in res.stdout + res.stderr  # nothing but the comparison ran
+    data = json.loads(ref.read_text())
+    data["claims"][0]["verdict"] = next(  # a verdict any key number can carry
+        v for v in ("not supported", "inconclusive") if v != data["claims"][0]["verdict"]
+    )
+    ref.write_text(json.dumps(data))
+    res = snakemake(wd, "-j1", "verify")
+    err = res.stdout + res.stderr
+    assert res.returncode != 0 and "verdict flipped" in err and "disagrees" in err
+    assert "Traceback" not in err and not (wd / "results/verify.md").exists()
+    data["config sha256"] = "another"
+    ref.write_text(json.dumps(data))
+    res = snakemake(wd, "-j1", "verify")
+    err = res.stdout + res.stderr
+    assert res.returncode != 0 and "same configuration" in err and "Traceback" not in err
 
 
 def test_j1_and_j2_give_identical_results(run_j2, tmp_path):
@@ -355,8 +395,8 @@ def test_slurm_profile_plans_every_rule(tmp_path):
         for line in out.splitlines()
         if line.startswith(("rule ", "localrule "))
     }
-    # the default target plans every rule except the four study-level target rules
-    assert planned == every - {"lqg", "estimators", "uav", "decisions"}
+    # the default target plans every rule except the four study-level target rules and verify
+    assert planned == every - {"lqg", "estimators", "uav", "decisions", "verify"}
     profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
     assert profile["executor"] == "slurm"
     block = out.split("rule estimators_ablation:", 1)[1].split("\n\n", 1)[0]
