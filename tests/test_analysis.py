@@ -1,15 +1,23 @@
-"""Aggregation, verdict rules, report rendering, stats helpers and intermediate-file checks."""
+"""LQG study: aggregation, verdict rules, report section and figures; stats helpers and
+intermediate-file checks."""
 
 from __future__ import annotations
 
+import re
+
+import matplotlib.colors as mcolors
 import numpy as np
 import pandas as pd
 import pytest
+from scipy import stats as sps
 
 from rsmhp import lqg
 from rsmhp.analysis import lqg as analysis
 from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, run_convergence, run_nbo_error
+from rsmhp.figures import lqg as figs
 from rsmhp.io import IntermediateFileError, read_table, write_csv
+from rsmhp.palette import method_colour
+from rsmhp.report import Section
 from rsmhp.stats import binomial_ci, loglog_slope, mean_ci, rmse_ci
 
 from .conftest import PAPER, PAPER_U
@@ -64,11 +72,60 @@ def test_fig3_and_prop3_verdicts_follow_the_data():
     good = synthetic({p: rng.normal(0, np.sqrt(var / p), 300) for p in ps})
     c2, c3, _ = analysis.convergence_claims(analysis.summarize_convergence(good, [1.0]), [1.0])
     assert c2.verdict == "supported" and c3.verdict == "supported"
-    # errors that do not shrink with P and are far larger than the bound allows
+    assert c2.key.null == 0.0 and c2.key.ci_high < 0
+    # errors that do not shrink with P and are far larger than NBO's error and the bound
     bad = synthetic({p: rng.normal(0, 15.0, 300) for p in ps})
     c2b, c3b, _ = analysis.convergence_claims(analysis.summarize_convergence(bad, [1.0]), [1.0])
-    assert c2b.verdict != "supported"
-    assert c3b.verdict == "not supported"
+    assert c2b.verdict == "not supported"
+    assert c3b.verdict == "not supported" and c3b.key.value >= 1
+
+
+def _pm(s: float, n: int = 40) -> np.ndarray:
+    """n errors, half +s and half -s: mean 0 and RMSE exactly s."""
+    return np.repeat([s, -s], n // 2)
+
+
+def test_fig3_verdict_edge_cases():
+    ps = [100, 400, 1600, 6400]
+    # RMSE that does not fall with P (slope CI around 0), far below NBO's error: inconclusive
+    flat = synthetic(dict(zip(ps, [_pm(1.0), _pm(1.2), _pm(0.9), _pm(1.1)], strict=True)))
+    c = analysis.fig3_claim(analysis.summarize_convergence(flat, [1.0]))
+    assert c.key.ci_low < 0 < c.key.ci_high and c.verdict == "inconclusive"
+    # RMSE falls like P^-1/2, but the mean keeps a bias of 0.5 at the largest P: inconclusive
+    shrinking = {p: _pm(20 / np.sqrt(p)) for p in ps}
+    biased = synthetic({p: e + 0.5 for p, e in shrinking.items()})
+    c = analysis.fig3_claim(analysis.summarize_convergence(biased, [1.0]))
+    assert c.key.ci_high < 0 and c.verdict == "inconclusive"
+    c = analysis.fig3_claim(analysis.summarize_convergence(synthetic(shrinking), [1.0]))
+    assert c.verdict == "supported" and c.key.value == pytest.approx(-0.5)
+
+
+def test_chebyshev_verdict_edge_cases():
+    rng = np.random.default_rng(1)
+    var = lqg.cost_variance(PAPER_U, **PAPER)
+    # every bound Var(g)/(P eps^2) >= 1: no evidence, the cells are named as left out
+    vac = synthetic({p: rng.normal(0, 1, 50) for p in (100, 200, 300)})
+    c = analysis.chebyshev_claim(analysis.summarize_convergence(vac, [0.25]), [0.25])
+    assert c.verdict == "inconclusive" and c.key.value == 0
+    assert c.dropped.startswith("3 of 3 cells")
+    # three informative cells; the first exceeds its bound per cell (95% Clopper-Pearson lower
+    # limit above it) but not familywise (Bonferroni over 3 cells): supported
+    ps, n = [6400, 12800, 25600], 300
+    bound = var / ps[0]
+    k = next(
+        k
+        for k in range(n)
+        if binomial_ci(k, n)[0] > bound and binomial_ci(k, n, 1 - 0.05 / 3)[0] <= bound
+    )
+    errs = {ps[0]: np.r_[np.full(k, 1.5), np.zeros(n - k)], ps[1]: np.zeros(n), ps[2]: np.zeros(n)}
+    c = analysis.chebyshev_claim(analysis.summarize_convergence(synthetic(errs), [1.0]), [1.0])
+    assert c.verdict == "supported" and c.key.value == 0 and not c.dropped
+    assert "lower limits above the bound (no familywise correction): 1" in c.measured
+    # one more exceedance than the familywise limit allows: not supported
+    k2 = next(k2 for k2 in range(k, n) if binomial_ci(k2, n, 1 - 0.05 / 3)[0] > bound)
+    errs[ps[0]] = np.r_[np.full(k2, 1.5), np.zeros(n - k2)]
+    c = analysis.chebyshev_claim(analysis.summarize_convergence(synthetic(errs), [1.0]), [1.0])
+    assert c.verdict == "not supported" and c.key.value == 1
 
 
 def test_weighted_verdict_detects_bias_and_agreement():
@@ -78,16 +135,56 @@ def test_weighted_verdict_detects_bias_and_agreement():
     assert analysis.convergence_claims(biased, [1.0])[2].verdict == "not supported"
     unbiased = analysis.summarize_convergence(synthetic(err), [1.0])
     assert analysis.convergence_claims(unbiased, [1.0])[2].verdict == "supported"
+    # a CI wide enough to hold both J and the derived limit J(sigma^2/2): inconclusive
+    wide = {p: _pm(30.0, 50) for p in (100, 200, 300)}
+    both = analysis.summarize_convergence(synthetic(wide, weighted_offset=lim_gap / 2), [1.0])
+    c = analysis.weighted_claim(both)
+    assert c.key.ci_low < J + lim_gap and c.key.ci_high > J
+    assert c.verdict == "inconclusive"
+
+
+def _nbo_grid(z: list[float]) -> pd.DataFrame:
+    """An NBO-error summary with prescribed z-scores (closed form 10, SE 0.1)."""
+    n = len(z)
+    sim = 10.0 + 0.1 * np.asarray(z)
+    return pd.DataFrame(
+        {
+            "a": np.linspace(0.1, 0.9, n),
+            "H": 1,
+            "n_replicates": 3,
+            "P": 50,
+            "u_value": 0.3,
+            "nbo_error_sim": sim,
+            "se": 0.1,
+            "ci_low": sim - 0.196,
+            "ci_high": sim + 0.196,
+            "nbo_error_closed": 10.0,
+            "z": z,
+            "rel_dev": (sim - 10.0) / 10.0,
+        }
+    )
 
 
 def test_nbo_error_claim_rejects_a_wrong_formula():
     conv = run_convergence(BASE, seed=2)
     nbo = analysis.summarize_nbo_error(run_nbo_error(BASE, seed=2))
-    summary = analysis.summarize_convergence(conv, [1.0])
-    assert analysis.nbo_error_claim(nbo, summary, conv).verdict in ("supported", "not supported")
+    assert analysis.nbo_error_claim(nbo, conv).verdict in ("supported", "not supported")
     wrong = nbo.assign(nbo_error_closed=nbo["nbo_error_closed"] * 1.5)
     wrong = wrong.assign(z=(wrong["nbo_error_sim"] - wrong["nbo_error_closed"]) / wrong["se"])
-    assert analysis.nbo_error_claim(wrong, summary, conv).verdict == "not supported"
+    assert analysis.nbo_error_claim(wrong, conv).verdict == "not supported"
+
+
+def test_nbo_error_verdict_at_the_bonferroni_limit():
+    # the paper's setting with J_P = J exactly: z = 0 there, so the grid decides
+    conv = synthetic({100: np.zeros(4), 200: np.zeros(4)})
+    assert analysis.paper_setting_nbo_error(conv).z == pytest.approx(0.0, abs=1e-9)
+    limit = analysis.nbo_z_limit(4)  # 4 grid cells + the paper's setting = 5 tests
+    assert limit == pytest.approx(sps.norm.ppf(1 - 0.025 / 5))
+    at = analysis.nbo_error_claim(_nbo_grid([0.1, -limit, 0.5, 1.0]), conv)
+    assert at.verdict == "supported" and at.key.value == pytest.approx(limit)
+    assert "over 5 tests" in at.key.name and at.key.reproducible == "bitwise"
+    above = analysis.nbo_error_claim(_nbo_grid([0.1, -limit - 0.01, 0.5, 1.0]), conv)
+    assert above.verdict == "not supported"
 
 
 def test_read_table_reports_corrupt_files(tmp_path):
@@ -115,3 +212,102 @@ def test_stats_helpers():
     assert noisy.contains(-0.5) and noisy.high - noisy.low > 0.01
     r, lo, hi = rmse_ci(np.array([3.0, -4.0]))
     assert r == pytest.approx(np.sqrt(12.5)) and lo < r < hi
+
+
+EPS = [0.25, 1.0]
+
+
+@pytest.fixture(scope="module")
+def small():
+    """Summaries, tables and the section of the small LQG configuration (tests/test_seeding)."""
+    conv = run_convergence(BASE, seed=2)
+    nbo = analysis.summarize_nbo_error(run_nbo_error(BASE, seed=2))
+    summary = analysis.summarize_convergence(conv, EPS)
+    tables = analysis.lqg_tables(summary, nbo, EPS)
+    section = analysis.lqg_section(summary, nbo, conv, EPS, tables)
+    return {"conv": conv, "nbo": nbo, "summary": summary, "tables": tables, "section": section}
+
+
+def _column(table: str, header: str) -> list[str]:
+    """Cells of column ``header`` of a Markdown table."""
+    rows = [[c.strip() for c in line.strip().strip("|").split("|")] for line in table.splitlines()]
+    i = rows[0].index(header)
+    return [r[i] for r in rows[2:]]
+
+
+def test_section_budget_numbers_and_roundtrip(small, tmp_path):
+    section = small["section"]
+    assert len(section.body.encode("utf-8")) <= 2600
+    assert [c.id for c in section.claims] == ["LQG-1", "LQG-2", "LQG-3", "LQG-4"]
+    for text in (section.body, section.appendix, *(c.measured for c in section.claims)):
+        assert not re.search(r"\b(nan|inf)\b", text, re.IGNORECASE), text
+        # integers (P, H, counts of replicates, trajectories, cells, tests) have no decimals
+        assert not re.search(r"\b[PHR] = \d+\.\d", text), text
+        assert not re.search(r"\d\.\d+ (replicates|trajectories|cells|tests|checks)", text), text
+    for c in section.claims:
+        assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300
+    conv_table = small["tables"]["lqg_convergence"]
+    assert _column(conv_table, "P") == ["20", "40", "60"]
+    assert set(_column(conv_table, "replicates")) == {"4"}
+    cheb = small["tables"]["lqg_chebyshev"]
+    assert all(re.fullmatch(r"\d+", v) for v in _column(cheb, "exceedances"))
+    for name in analysis.FIGURES:
+        assert f"(figures/{name}.png)" in section.body
+    assert section.figures == [f"{f}.png" for f in analysis.FIGURES]
+    for key in ("x_k", "u_k", "w_k", "σ", "weight r", "target T", "horizon H", "J_NBO", "Var(g)"):
+        assert key in section.body
+    for stem in analysis.TABLES:
+        assert small["tables"][stem] in section.appendix
+    section.save(tmp_path / "lqg.json")
+    assert Section.load(tmp_path / "lqg.json") == section
+
+
+def _hex(c) -> str:
+    return mcolors.to_hex(c)
+
+
+def test_figures_use_the_method_colours(small):
+    conv, summary, nbo = small["conv"], small["summary"], small["nbo"]
+    fig = figs.fig3_paper_figure(conv, summary)
+    (ax,) = fig.axes
+    colours = {ln.get_label().split()[0]: _hex(ln.get_color()) for ln in ax.get_lines()}
+    assert colours == {
+        "MHP": method_colour("mc"),
+        "exact": method_colour("exact"),
+        "NBO": method_colour("nbo"),
+    }
+    assert not ax.collections  # the paper's way: one realisation and two lines, nothing else
+    assert ax.get_title() and "P" in ax.get_xlabel() and "cost" in ax.get_ylabel()
+    fig = figs.convergence_figure(conv, summary)
+    for ax in fig.axes:
+        assert ax.get_title() and ax.get_xlabel() and "cost" in ax.get_ylabel()
+    mean = [ln for ln in fig.axes[0].get_lines() if ln.get_label() == "MHP J_P, mean"]
+    assert _hex(mean[0].get_color()) == method_colour("mc")
+    for coll in fig.axes[0].collections:
+        assert _hex(coll.get_facecolor()[0]) == method_colour("mc")
+    fig = figs.error_loglog_figure(summary, EPS)
+    nbo_line = [ln for ln in fig.axes[0].get_lines() if ln.get_label().startswith("NBO")]
+    assert _hex(nbo_line[0].get_color()) == method_colour("nbo")
+    fig = figs.nbo_error_figure(nbo)
+    top, resid = fig.axes
+    assert "cost" in top.get_ylabel() and "SE" in resid.get_ylabel()
+    limit = analysis.nbo_z_limit(len(nbo))
+    levels = sorted(ln.get_ydata()[0] for ln in resid.get_lines())
+    assert levels == pytest.approx([-limit, 0.0, limit])
+    assert len(set(map(str, figs.nbo_shades(4)))) == 4
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_nbo_residual_panel_clips_and_says_so(small):
+    import matplotlib.pyplot as plt
+
+    nbo = small["nbo"].copy()
+    nbo.loc[0, "z"] = 50.0
+    fig = figs.nbo_error_figure(nbo)
+    resid = fig.axes[1]
+    assert resid.get_ylim()[1] < 50
+    texts = [t.get_text() for t in resid.texts]
+    assert any("1 residuals beyond ±8 drawn at the edge" in t for t in texts)
+    plt.close(fig)

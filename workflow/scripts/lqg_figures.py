@@ -1,7 +1,9 @@
-"""Rule lqg_figures: Fig. 3 analogue, error vs P with Chebyshev, NBO error (PNG + PDF)."""
+"""Rule lqg_figures: paper-style Fig. 3, its statistical view, error vs P with Chebyshev, NBO
+error with residuals (PNG + PDF)."""
 
 from pathlib import Path
 
+from rsmhp.analysis.lqg import eps_label
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.lqg import convergence_contract
 from rsmhp.figures import lqg as figs
@@ -12,6 +14,11 @@ from rsmhp.pipeline import rule_logging
 with rule_logging(snakemake.log[0], snakemake.rule):
     eps = list(snakemake.params.eps)
     conv = read_checked(snakemake.input.convergence, convergence_contract(snakemake.params.lqg))
+    per_eps = [
+        f"{col}_eps{eps_label(e)}"
+        for e in eps
+        for col in ("bound", "exceed", "exceed_low", "exceed_high")
+    ]
     summary = read_table(
         snakemake.input.summary,
         [
@@ -26,13 +33,14 @@ with rule_logging(snakemake.log[0], snakemake.rule):
             "J_exact",
             "J_nbo",
             "n_replicates",
-            *(f"bound_eps{e:g}" for e in eps),
+            *per_eps,
         ],
     )
     nbo = read_table(
-        snakemake.input.nbo_summary, ["a", "H", "nbo_error_sim", "nbo_error_closed", "se"]
+        snakemake.input.nbo_summary, ["a", "H", "nbo_error_sim", "nbo_error_closed", "se", "z"]
     )
     outdir = Path(snakemake.output[0]).parent
+    save_figure(figs.fig3_paper_figure(conv, summary), outdir / "lqg_fig3_paper")
     save_figure(figs.convergence_figure(conv, summary), outdir / "lqg_convergence")
     save_figure(figs.error_loglog_figure(summary, eps), outdir / "lqg_error_loglog")
     save_figure(figs.nbo_error_figure(nbo), outdir / "lqg_nbo_error")
