@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import copy
+import re
 from pathlib import Path
 
 import numpy as np
@@ -13,6 +14,8 @@ from rerun.chunk import RrdReader
 
 from rsmhp.analysis import uav as analysis
 from rsmhp.experiments.uav import NONDETERMINISTIC_COLUMNS, RUN_COLUMNS, run_chunk
+from rsmhp.palette import method_colour, method_label, method_rgb
+from rsmhp.report import Section, fmt, render_appendix, render_report
 from rsmhp.uav import simulation
 from rsmhp.uav.recording import record_uav_run
 from rsmhp.uav.simulation import UAVSetup, draw_scenario, method_specs, simulate_run
@@ -120,22 +123,38 @@ def test_recording_contents_and_consistency(short_cfg, tmp_path):
         assert _det(s) == _det(ref)
 
 
-def _runs(diff: np.ndarray) -> pd.DataFrame:
+def _runs(diff: np.ndarray, tree: bool = False, base: np.ndarray | None = None) -> pd.DataFrame:
+    """Synthetic runs: NBO error ``base`` (default 10..20 m), RS-MHP N_T=50 ``base + diff``,
+    N_T=250 ``base + 2 diff`` and (``tree``) a pruned tree keeping 250, ``base + 3 diff``."""
     n = diff.size
-    base = np.linspace(10, 20, n)
+    base = np.linspace(10, 20, n) if base is None else base
+    methods = [
+        ("nbo", "nbo", 1, 0, 0, base),
+        ("rsmhp_nt50", "rsmhp", 50, 0, 0, base + diff),
+        ("rsmhp_nt250", "rsmhp", 250, 0, 0, base + 2 * diff),
+    ]
+    if tree:
+        methods.append(("tree_n8_m250", "tree", 250, 8, 250, base + 3 * diff))
     rows = []
-    for name, fam, nt, err in (
-        ("nbo", "nbo", 1, base),
-        ("rsmhp_nt50", "rsmhp", 50, base + diff),
-        ("rsmhp_nt250", "rsmhp", 250, base + 2 * diff),
-    ):
+    for name, fam, nt, N, M, err in methods:
         rows += [
-            {"method": name, "family": fam, "N_T": nt, "N": 0, "M": 0, "run": r, "seed": 0,
-             "mean_error": e, "rmse": e, "final_error": e, "mean_trace": 1.0, "mean_nit": 1.0,
+            {"method": name, "family": fam, "N_T": nt, "N": N, "M": M, "run": r, "seed": 0,
+             "mean_error": e, "rmse": e, "final_error": e, "mean_trace": 250.0, "mean_nit": 4.5,
              "plan_seconds": 0.1}
             for r, e in enumerate(err)
         ]  # fmt: skip
     return pd.DataFrame(rows, columns=RUN_COLUMNS)
+
+
+def _centred_noise(n: int, sd: float, seed: int = 0) -> np.ndarray:
+    noise = np.random.default_rng(seed).standard_normal(n)
+    return sd * (noise - noise.mean()) / noise.std()
+
+
+def _analyse(runs: pd.DataFrame, n_boot: int = 2000):
+    summary = analysis.summarize_methods(runs, seed=1, n_boot=n_boot)
+    paired = analysis.paired_differences(runs, seed=1, n_boot=n_boot)
+    return summary, paired
 
 
 @pytest.mark.parametrize(
@@ -143,17 +162,181 @@ def _runs(diff: np.ndarray) -> pd.DataFrame:
     [(-0.5, "supported"), (0.5, "not supported"), (0.0, "inconclusive")],
 )
 def test_verdict_rules(shift, verdict):
-    rng = np.random.default_rng(0)
     # differences shift + N(0, 0.3^2)-like spread (exactly centred), 200 runs: the bootstrap
     # CI half-width is about 1.96 * 0.3 / sqrt(200) = 0.04, far from |shift| = 0.5
-    noise = rng.standard_normal(200)
-    noise = 0.3 * (noise - noise.mean()) / noise.std()
-    runs = _runs(shift + noise)
-    summary = analysis.summarize_methods(runs, seed=1, n_boot=2000)
-    paired = analysis.paired_differences(runs, seed=1, n_boot=2000)
-    claims = {c.id: c.verdict for c in analysis.uav_claims(summary, paired)}
-    assert claims == {"UAV-1": verdict, "UAV-2": verdict}
+    runs = _runs(shift + _centred_noise(200, 0.3), tree=True)
+    summary, paired = _analyse(runs)
+    claims = {c.id: c for c in analysis.uav_claims(summary, paired)}
+    # UAV-3: d = e(N_T=250) - e(tree) = -shift per run: the opposite verdict
+    opposite = {"supported": "not supported", "not supported": "supported"}.get(verdict, verdict)
+    assert {k: c.verdict for k, c in claims.items()} == {
+        "UAV-1": verdict,
+        "UAV-2": verdict,
+        "UAV-3": opposite,
+    }
     row = paired[(paired["method"] == "rsmhp_nt250") & (paired["baseline"] == "nbo")].iloc[0]
     assert row["ci_low"] <= row["mean_diff"] <= row["ci_high"]
     assert row["mean_diff"] == pytest.approx(2 * shift, abs=1e-12)
+    key = claims["UAV-2"].key
+    assert (key.value, key.ci_low, key.ci_high) == (row["mean_diff"], row["ci_low"], row["ci_high"])
+    for c in claims.values():
+        assert c.key.reproducible == "statistical" and c.key.null == 0.0 and c.key.unit == "m"
+        assert isinstance(c.key.value, float) and c.key.has_ci
+        assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300
     pd.testing.assert_frame_equal(paired, analysis.paired_differences(runs, seed=1, n_boot=2000))
+
+
+@pytest.mark.parametrize(
+    ("lo", "hi", "expected"),
+    [
+        (-0.3, -1e-12, "supported"),
+        (-0.3, 0.0, "inconclusive"),  # the CI touches 0
+        (-0.3, 0.2, "inconclusive"),  # the CI contains 0
+        (0.0, 0.3, "inconclusive"),
+        (1e-12, 0.3, "not supported"),
+    ],
+)
+def test_verdict_rule_edges(lo, hi, expected):
+    assert analysis.verdict(lo, hi) == expected
+    # the same through uav_claims, from a synthetic paired table with exactly this CI
+    summary, paired = _analyse(_runs(_centred_noise(20, 0.3)), n_boot=200)
+    key = (paired["method"] == "rsmhp_nt250") & (paired["baseline"] == "nbo")
+    paired.loc[key, ["ci_low", "ci_high", "mean_diff"]] = [lo, hi, (lo + hi) / 2]
+    uav2 = next(c for c in analysis.uav_claims(summary, paired) if c.id == "UAV-2")
+    assert uav2.verdict == expected
+    assert (uav2.key.ci_low, uav2.key.ci_high) == (lo, hi)
+
+
+def _section(runs: pd.DataFrame, n_boot: int = 500):
+    summary, paired = _analyse(runs, n_boot)
+    tables = analysis.uav_tables(summary, paired)
+    return analysis.uav_section(summary, paired, tables, DEFAULT_UAV, n_boot, runs), tables
+
+
+def _no_bad_numbers(text: str) -> None:
+    assert not re.search(r"\b(nan|inf|NaN|Inf|None)\b", text), text
+    # integers are printed as integers (no 100.0 runs, 60.0 steps, Δt = 1.0 s)
+    assert not re.search(r"(?<![\d.])\d+\.0\b(?!\d)", text), re.findall(r"\S*\d+\.0\b\S*", text)
+
+
+@pytest.mark.parametrize("zero_diff", [False, True])
+def test_section_budget_and_formatting(tmp_path, zero_diff):
+    # 200 runs; with zero_diff every method has the same errors: Wilcoxon p is undefined
+    diff = np.zeros(200) if zero_diff else _centred_noise(200, 0.05) + 0.01
+    base = np.linspace(8, 16, 200)
+    base[-1] = 61.7  # one far outlier run: clipped in the CDFs, counted in the captions
+    runs = _runs(diff, tree=True, base=base)
+    section, tables = _section(runs)
+    assert len(section.body.encode("utf-8")) <= 2600
+    for stem in analysis.FIGURES:
+        assert f"](figures/{stem}.png)" in section.body
+    assert section.figures == [f"{f}.png" for f in analysis.FIGURES]
+    assert "| UAV-" not in section.body and "### Claims" not in section.body
+    clipped = re.findall(
+        r"1 run per curve beyond [\d.]+ m not shown \(up to 61.[78] m\)", section.body
+    )
+    assert len(clipped) == 2  # both CDF captions
+    for name in ("uav_methods", "uav_paired"):
+        assert tables[name] in section.appendix
+    # symbols are defined in the body
+    for symbol in ("N_T", "H = 6", "e_r = (1/K)", "d_r = e_r(A) − e_r(B)", "CI:", "p:"):
+        assert symbol in section.body, symbol
+    report = render_report([section], {"commit": "x"})
+    appendix = render_appendix([section], {}, {})
+    for text in (section.body, section.appendix, report, appendix):
+        _no_bad_numbers(text)
+    if zero_diff:
+        assert "n/a" in tables["uav_paired"] and "test is undefined" in tables["uav_paired"]
+        assert all(c.verdict == "inconclusive" for c in section.claims)
+    # the runs column and the counts are integers
+    assert re.search(r"\|\s+200 \|", tables["uav_methods"])
+    section.save(tmp_path / "uav.json")
+    assert Section.load(tmp_path / "uav.json") == section
+
+
+def test_robust_range_and_clip_note():
+    x = np.r_[np.linspace(10, 14, 99), 40.0]
+    lo, hi = analysis.robust_range(x)
+    assert lo == 10.0 and 14.0 <= hi < 40.0
+    groups = {"a": x, "b": x + 0.01}
+    assert analysis.clip_note(groups, lo, hi) == (
+        f"1 run per curve beyond {fmt(hi)} m not shown (up to {fmt(40.01)} m)"
+    )
+    tight = np.linspace(10, 14, 7)
+    assert analysis.robust_range(tight) == (10.0, 14.0)  # nothing out: the data range
+    assert analysis.clip_note({"a": tight}, 10.0, 14.0) == ""
+    note = analysis.clip_note({"a": np.r_[tight, -9.0, 30.0]}, 10.0, 14.0, "differences")
+    assert note.startswith("2 of 9 differences outside [10.0, 14.0] m not shown")
+
+
+def test_figure_colours_match_palette():
+    from matplotlib.colors import to_hex
+
+    from rsmhp.figures import uav as figs
+
+    runs = _runs(_centred_noise(40, 0.3), tree=True)
+    summary, paired = _analyse(runs, n_boot=200)
+    fig = figs.error_cdf_nt_figure(runs, summary)
+    ax = fig.axes[0]
+    got = {ln.get_label().split(" (")[0]: to_hex(ln.get_color()) for ln in ax.get_lines()}
+    assert got == {method_label(m): method_colour(m) for m in ("rsmhp_nt50", "rsmhp_nt250")}
+    assert ax.get_title() and "(m)" in ax.get_xlabel()
+    fig = figs.error_cdf_nbo_figure(runs, summary)
+    got = {ln.get_label().split(" (")[0]: to_hex(ln.get_color()) for ln in fig.axes[0].get_lines()}
+    assert got == {method_label(m): method_colour(m) for m in ("nbo", "rsmhp_nt250")}
+    for draw, view in (
+        (figs.paired_diff_figure, "nbo"),
+        (figs.paired_diff_nt_figure, "nt"),
+    ):
+        fig = draw(runs, summary, paired)
+        left = fig.axes[0]
+        colours = [to_hex(c.get_facecolor()[0][:3]) for c in left.collections]
+        rows = analysis.paired_view(paired, view)
+        assert colours == [method_colour(m) for m in rows["method"]]
+        assert fig._suptitle is not None and "(m" in left.get_xlabel()
+    import matplotlib.pyplot as plt
+
+    plt.close("all")
+
+
+def test_recording_colours_are_the_palette(short_cfg, tmp_path):
+    from rsmhp.uav.recording import EST_C, TRUE_C
+
+    palette = [method_colour(m) for m in ("nbo", "mc", "tree", "tree_pernode", "pruned",
+               "antithetic", "sobol", "cubature", "gauss_hermite", "exact")]  # fmt: skip
+    palette += [method_colour(f"rsmhp_nt{n}") for n in (10, 50, 100, 250, 1000)]
+    rgb = [tuple(int(h[i : i + 2], 16) for i in (1, 3, 5)) for h in palette]
+    for c in (TRUE_C, EST_C):
+        assert min(np.linalg.norm(np.subtract(c, p)) for p in rgb) > 100
+    setup = UAVSetup.from_config(short_cfg)
+    specs = list(method_specs(short_cfg).values())
+    path = tmp_path / "run.rrd"
+    record_uav_run(path, setup, specs, seed=5, run=1, max_hypotheses=2)
+
+    def packed(c, alpha=255):
+        return (c[0] << 24) | (c[1] << 16) | (c[2] << 8) | alpha
+
+    seen: dict[str, set[int]] = {}
+    for chunk in RrdReader(path).store().stream():
+        batch = chunk.to_record_batch()
+        for col in batch.schema.names:
+            if col.endswith(":colors"):
+                for cell in batch.column(col).to_pylist():
+                    seen.setdefault(chunk.entity_path, set()).update(cell or [])
+    for m in specs:
+        c = method_rgb(m.name)
+        for ent in ("uav_path", "uav"):
+            assert seen[f"/{m.name}/map/{ent}"] == {packed(c)}
+        assert {v >> 8 for v in seen[f"/{m.name}/map/plan"]} == {packed(c) >> 8}
+        assert seen[f"/{m.name}/map/target"] == {packed(TRUE_C)}
+        assert seen[f"/{m.name}/map/estimate"] == {packed(EST_C)}
+        assert seen[f"/error/{m.name}"] == {packed(c)}
+
+
+def test_figure_lists_agree():
+    """The workflow's figure list (rule outputs, report inputs) is the section's FIGURES."""
+    smk = (ROOT / "workflow" / "rules" / "uav.smk").read_text()
+    listed = re.search(r"UAV_FIGURES = \[(.*?)\]", smk, re.S).group(1)
+    assert re.findall(r'"(\w+)"', listed) == list(analysis.FIGURES)
+    for stem in analysis.FIGURES:
+        assert (ROOT / "workflow" / "report" / f"{stem}.rst").read_text().strip()

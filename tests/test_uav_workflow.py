@@ -8,7 +8,9 @@ import pytest
 import yaml
 from rerun.chunk import RrdReader
 
+from rsmhp.analysis.uav import FIGURES
 from rsmhp.experiments.uav import NONDETERMINISTIC_COLUMNS
+from rsmhp.report import Section, fmt
 from tests.test_workflow import TINY, snakemake
 
 pytestmark = pytest.mark.workflow
@@ -58,17 +60,23 @@ def test_uav_summary_tables_figures_report(run_j2, tiny):
     for name in ("uav_methods", "uav_paired"):
         text = (run_j2 / f"results/tables/{name}.md").read_text()
         assert text.startswith("|") and text.count("\n") >= 4
-    for name in ("uav_error_cdf_nt", "uav_error_cdf_nbo", "uav_paired_diff"):
+    for name in FIGURES:
         png = (run_j2 / f"results/figures/{name}.png").read_bytes()
         assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
         assert (run_j2 / f"results/figures/{name}.pdf").read_bytes()[:5] == b"%PDF-"
         assert (run_j2 / f"results/paper/figures/{name}.png").read_bytes() == png
     report = (run_j2 / "results/paper/replication.md").read_text()
+    appendix = (run_j2 / "results/paper/appendix.md").read_text()
     for cid in ("UAV-1", "UAV-2", "UAV-3"):
-        assert f"| {cid} |" in report
+        assert f"| {cid} |" in report and f"### {cid} (" in appendix
     assert "## Case study 2: UAV target tracking" in report
+    for name in FIGURES:
+        assert f"](figures/{name}.png)" in report
     big = summary[summary["family"] == "rsmhp"].sort_values("N_T").iloc[-1]
-    assert f"RS-MHP N_T={int(big['N_T'])}: {big['mean']:.2f} m" in report
+    assert f"{big['label']} {fmt(big['mean'], 4)} m" in appendix
+    section = Section.load(run_j2 / "results/report/uav.json")
+    assert len(section.body.encode("utf-8")) <= 2600
+    assert [c.key.reproducible for c in section.claims] == ["statistical"] * 3
     for rule in ("uav_collect", "uav_summary", "uav_figures"):
         assert "done in" in (run_j2 / f"results/logs/{rule}.log").read_text()
         assert (run_j2 / f"results/benchmarks/{rule}.tsv").exists()
@@ -115,8 +123,8 @@ def test_adding_nt_value_reruns_no_existing_simulation(run_j2, tmp_path, tiny):
 
 
 def test_paired_diff_figure_redraws_identically(run_j2, tmp_path):
-    """seaborn's strip-plot jitter draws from NumPy's legacy global generator; the figure seeds
-    it from a stable id and restores it, so two redraws give the same bytes."""
+    """The strip jitter comes from the figure's own seeded generator (not NumPy's legacy global
+    one, which stays untouched), so two redraws give the same bytes."""
     import numpy as np
     import pandas as pd
 

@@ -1,7 +1,9 @@
-"""Rule uav_figures: Fig. 4 and Fig. 5 analogues (ECDFs) and paired differences (PNG + PDF)."""
+"""Rule uav_figures: the paper's Figs. 4 and 5 drawn its way (CDFs of the per-run average
+error) and, for each, the paired view (per-run differences, mean and CI) (PNG + PDF)."""
 
 from pathlib import Path
 
+from rsmhp.analysis.uav import FIGURES
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.uav import runs_contract
 from rsmhp.figures import save_figure
@@ -14,9 +16,15 @@ with rule_logging(snakemake.log[0], snakemake.rule):
     runs = read_checked(snakemake.input.runs, runs_contract(p.methods, p.runs, p.seed))
     summary = read_table(snakemake.input.summary, ["method", "family", "label", "N_T", "n_runs"])
     paired = read_table(
-        snakemake.input.paired, ["method", "baseline", "mean_diff", "ci_low", "ci_high"]
+        snakemake.input.paired,
+        ["method", "baseline", "comparison", "purpose", "n_runs", "mean_diff", "ci_low", "ci_high"],
     )
+    draw = {
+        "uav_error_cdf_nt": lambda: figs.error_cdf_nt_figure(runs, summary),
+        "uav_paired_diff_nt": lambda: figs.paired_diff_nt_figure(runs, summary, paired),
+        "uav_error_cdf_nbo": lambda: figs.error_cdf_nbo_figure(runs, summary),
+        "uav_paired_diff": lambda: figs.paired_diff_figure(runs, summary, paired),
+    }
     outdir = Path(snakemake.output[0]).parent
-    save_figure(figs.error_cdf_nt_figure(runs, summary), outdir / "uav_error_cdf_nt")
-    save_figure(figs.error_cdf_nbo_figure(runs, summary), outdir / "uav_error_cdf_nbo")
-    save_figure(figs.paired_diff_figure(runs, summary, paired), outdir / "uav_paired_diff")
+    for stem in FIGURES:
+        save_figure(draw[stem](), outdir / stem)

@@ -20,6 +20,6 @@ with rule_logging(snakemake.log[0], snakemake.rule):
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
     section = analysis.uav_section(
-        summary, paired, tables, snakemake.params.setting, an["bootstrap"]
+        summary, paired, tables, snakemake.params.setting, an["bootstrap"], runs
     )
     section.save(snakemake.output.section)

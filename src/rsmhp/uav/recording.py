@@ -1,22 +1,28 @@
 """Rerun recordings of UAV runs, every method side by side (open with ``rerun <file>.rrd``).
 
 One recording per run ``r`` (``results/recordings/uav_run<r>.rrd``), timeline ``step``.
-For each method ``<m>`` (entity per method, its own 2-D view):
+For each method ``<m>`` (entity per method, its own 2-D view), drawn in the method's colour
+``c_m = rsmhp.palette.method_rgb(m)`` (the same colour as in every figure):
 
-* ``<m>/map/uav_path``      LineStrips2D: the UAV's path up to step k
-* ``<m>/map/uav``           Points2D: the UAV now
-* ``<m>/map/plan``          LineStrips2D: the H-step UAV path planned at step k (from the
-  position before the step)
-* ``<m>/map/hypotheses``    LineStrips2D: the target hypotheses the planner used at step k
-  (at most ``max_hypotheses`` of them, the first ones drawn)
-* ``<m>/map/target_path``, ``<m>/map/target``  the true target (identical for every method)
+* ``<m>/map/uav_path``      LineStrips2D in ``c_m``: the UAV's path up to step k
+* ``<m>/map/uav``           Points2D in ``c_m``: the UAV now
+* ``<m>/map/plan``          LineStrips2D in ``c_m`` (translucent, thinner): the H-step UAV path
+  planned at step k (from the position before the step)
+* ``<m>/map/hypotheses``    LineStrips2D in ``c_m`` (faint): the target hypotheses the planner
+  used at step k (at most ``max_hypotheses`` of them, the first ones drawn)
+* ``<m>/map/target_path``, ``<m>/map/target``  the true target (identical for every method),
+  in :data:`TRUE_C` (lime)
 * ``<m>/map/estimate``, ``<m>/map/ellipse``  the tracker's estimate and its 2-sigma position
   ellipse (closed polygon of :math:`\\hat p + 2 L (\\cos t, \\sin t)`, :math:`L L^T` the
-  position block of :math:`\\hat P`; ``Ellipses2D`` has no rotation)
+  position block of :math:`\\hat P`; ``Ellipses2D`` has no rotation), in :data:`EST_C`
+  (magenta)
 * ``<m>/map/footprint``    LineStrips2D (model variants with a sensor footprint only): the
-  footprint circle around the UAV, green when the step measured, red when it did not
-* ``error/<m>``, ``trace/<m>``  Scalars: :math:`\\|\\hat p_k - p_k\\|` and
+  footprint circle around the UAV, in ``c_m`` when the step measured, faint when it did not
+* ``error/<m>``, ``trace/<m>``  Scalars in ``c_m``: :math:`\\|\\hat p_k - p_k\\|` and
   :math:`\\mathrm{tr}\\,\\hat P_k` (one time-series view each, methods overlaid)
+
+Target and estimate colours differ from every method colour of :mod:`rsmhp.palette` (RGB
+distance > 100), so they cannot be mistaken for a method.
 
 The recording id is derived from the job identifier: reruns write the same data.
 """
@@ -32,18 +38,18 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from rsmhp import guards
+from rsmhp.palette import method_rgb
 from rsmhp.seeding import canonical_job_id
 from rsmhp.uav.simulation import MethodSpec, StepInfo, UAVSetup, draw_scenario, simulate_run
 
-__all__ = ["ellipse_polygon", "record_uav_run", "uav_blueprint"]
+__all__ = ["EST_C", "TRUE_C", "ellipse_polygon", "record_uav_run", "uav_blueprint"]
 
-UAV_C = (30, 110, 220)
-PLAN_C = (120, 170, 255)
-TRUE_C = (20, 20, 20)
-EST_C = (220, 60, 40)
-HYP_C = (160, 160, 160, 90)
-SEEN_C = (40, 170, 70)
-MISSED_C = (210, 40, 40)
+#: the true target (path and position): lime, unlike any method colour
+TRUE_C = (120, 230, 0)
+#: the tracker's estimate and its ellipse: magenta, unlike any method colour
+EST_C = (230, 0, 230)
+#: alpha of the plan, the hypotheses and a footprint that did not measure (method colour)
+PLAN_ALPHA, HYP_ALPHA, MISSED_ALPHA = 170, 70, 70
 
 
 def ellipse_polygon(mean: np.ndarray, cov: np.ndarray, n_sigma: float = 2.0, n: int = 48):
@@ -74,6 +80,7 @@ class _MethodLogger:
         self.rec, self.log, self.name, self.max_hyp = rec, log, name, max_hypotheses
         self.footprint = footprint
         self.base = f"{name}/map"
+        self.rgb = method_rgb(name)
         self.uav_path = [np.asarray(uav_start, dtype=float).copy()]
         self.tgt_path: list[np.ndarray] = []
 
@@ -83,11 +90,12 @@ class _MethodLogger:
         plan = np.vstack([self.uav_path[-1], info.plan_path[:, :2]])
         self.uav_path.append(info.uav[:2].copy())
         self.tgt_path.append(info.target[:2].copy())
-        log(f"{base}/plan", rr.LineStrips2D([plan], colors=[PLAN_C], radii=1.0))
-        log(f"{base}/uav_path", rr.LineStrips2D([np.array(self.uav_path)], colors=[UAV_C]))
-        log(f"{base}/uav", rr.Points2D([info.uav[:2]], colors=[UAV_C], radii=6.0))
+        c = self.rgb
+        log(f"{base}/plan", rr.LineStrips2D([plan], colors=[(*c, PLAN_ALPHA)], radii=1.0))
+        log(f"{base}/uav_path", rr.LineStrips2D([np.array(self.uav_path)], colors=[c], radii=1.5))
+        log(f"{base}/uav", rr.Points2D([info.uav[:2]], colors=[c], radii=6.0))
         hyp = info.hypotheses[: self.max_hyp, :, :2]
-        log(f"{base}/hypotheses", rr.LineStrips2D(list(hyp), colors=[HYP_C], radii=0.5))
+        log(f"{base}/hypotheses", rr.LineStrips2D(list(hyp), colors=[(*c, HYP_ALPHA)], radii=0.5))
         log(f"{base}/target_path", rr.LineStrips2D([np.array(self.tgt_path)], colors=[TRUE_C]))
         log(f"{base}/target", rr.Points2D([info.target[:2]], colors=[TRUE_C], radii=4.0))
         log(f"{base}/estimate", rr.Points2D([info.estimate[:2]], colors=[EST_C], radii=4.0))
@@ -96,7 +104,7 @@ class _MethodLogger:
         if self.footprint is not None:
             t = np.linspace(0.0, 2 * np.pi, 73)
             ring = info.uav[:2] + self.footprint * np.column_stack([np.cos(t), np.sin(t)])
-            color = SEEN_C if info.detected else MISSED_C
+            color = c if info.detected else (*c, MISSED_ALPHA)
             log(f"{base}/footprint", rr.LineStrips2D([ring], colors=[color], radii=1.0))
         log(f"error/{self.name}", rr.Scalars(info.error))
         log(f"trace/{self.name}", rr.Scalars(info.trace))
@@ -155,8 +163,9 @@ def record_uav_run(
 
     summaries = []
     for m in methods:
-        log(f"error/{m.name}", rr.SeriesLines(names=m.name, widths=1.5), static=True)
-        log(f"trace/{m.name}", rr.SeriesLines(names=m.name, widths=1.5), static=True)
+        style = rr.SeriesLines(names=m.name, colors=[method_rgb(m.name)], widths=1.5)
+        log(f"error/{m.name}", style, static=True)
+        log(f"trace/{m.name}", style, static=True)
         start = draw_scenario(setup, seed, run).uav[:2]
         footprint = setup.sensor.footprint_radius if setup.sensor.limited else None
         observer = _MethodLogger(rec, log, m.name, start, max_hypotheses, footprint)
