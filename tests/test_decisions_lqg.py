@@ -3,11 +3,15 @@ against them (tolerances from the chi-square variance of the regret)."""
 
 from __future__ import annotations
 
+import re
+
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from matplotlib.colors import to_hex
 from scipy import stats
 from scipy.optimize import minimize
 
@@ -19,6 +23,8 @@ from rsmhp.experiments.decisions_lqg import (
     run_lqg_regret,
     sobol_budget,
 )
+from rsmhp.figures import decisions as figs
+from rsmhp.palette import method_colour
 from rsmhp.sampling import rollout_cost, sample_tree
 
 MODEL = {"x0": 0.0, "r": 10.0, "target": 1.0, "sigma": 1.0}
@@ -328,7 +334,6 @@ def test_claims_follow_their_rules():
     assert v["DEC-1"] == "not supported"  # NBO optimal
     assert v["DEC-2"] == "supported"  # chi2 draws with the closed-form mean
     assert v["DEC-3"] == "supported"
-    assert v["DEC-4"] == "not supported"  # flat in M
     v = _verdicts(_synthetic(nbo_regret=1.0, pruned_slope=-1.0))
     assert v["DEC-1"] == "supported"  # 1.0 is far above 1% of J*
     assert v["DEC-4"] == "supported"
@@ -338,9 +343,265 @@ def test_a_wrong_closed_form_is_detected():
     df = _synthetic(nbo_regret=0.0, pruned_slope=0.0)
     df.loc[df.method == "tree", "regret"] *= 1.5  # 50% off the closed form
     assert _verdicts(df)["DEC-3"] == "not supported"
+    df = _synthetic(nbo_regret=0.0, pruned_slope=0.0)
+    df.loc[df.method == "mc", "regret"] *= 1.5
+    assert _verdicts(df)["DEC-2"] == "not supported"  # slopes fine, |z| far beyond the limit
 
 
-def test_summary_z_scores_and_tables():
+# ------------------------------------------------- verdict rules on hand-made summaries
+
+_SUMMARY_DEFAULTS = {"problem": "p", "N": 0, "M": 0, "n": 500, "median": 1.0, "J_star": 10.0}
+
+
+def _summary(rows: list[dict]) -> pd.DataFrame:
+    out = []
+    for r in rows:
+        r = {**_SUMMARY_DEFAULTS, **r}
+        r.setdefault("mean", 1.0)
+        r.setdefault("ci_low", r["mean"])
+        r.setdefault("ci_high", r["mean"])
+        r.setdefault("rel_mean", r["mean"] / r["J_star"])
+        r.setdefault("closed_form", np.nan)
+        r.setdefault("closed_kind", "none")
+        r.setdefault("z", np.nan)
+        out.append(r)
+    return pd.DataFrame(out, columns=dec.LQG_SUMMARY_COLUMNS)
+
+
+def _scaling(method: str, fits: list[tuple[float, float, float]]) -> pd.DataFrame:
+    """One slope fit (slope, low, high) per (a, H) cell a = 0.5, H = 2, 3, ..."""
+    return pd.DataFrame(
+        [
+            {
+                "a": 0.5,
+                "H": 2 + i,
+                "method": method,
+                "weighting": "uniform",
+                "x": "N" if method == "tree" else "P",
+                "n_points": 6,
+                "slope": s,
+                "low": lo,
+                "high": hi,
+            }
+            for i, (s, lo, hi) in enumerate(fits)
+        ],
+        columns=dec.SCALING_COLUMNS,
+    )
+
+
+def _claim(summary: pd.DataFrame, scaling: pd.DataFrame, cid: str):
+    return {c.id: c for c in dec.lqg_claims(summary, scaling, MODEL)}[cid]
+
+
+@pytest.mark.parametrize(
+    "rel, verdict",
+    [
+        (1e-31, "not supported"),
+        (1e-9, "not supported"),
+        (1e-4, "inconclusive"),
+        (0.01, "supported"),
+    ],
+)
+def test_dec1_rule_edges(rel, verdict):
+    summary = _summary(
+        [
+            {
+                "a": 0.5,
+                "H": 2,
+                "method": "nbo",
+                "weighting": "uniform",
+                "P": 1,
+                "n": 1,
+                "mean": 10.0 * rel,
+                "closed_form": 0.0,
+                "closed_kind": "exact",
+            }
+        ]
+    )
+    c = _claim(summary, _scaling("mc", [])[:0], "DEC-1")
+    assert c.verdict == verdict
+    assert c.key.value == pytest.approx(rel) and c.key.reproducible == "bitwise"
+    assert not c.key.has_ci
+
+
+def _mc_summary(z: float) -> pd.DataFrame:
+    return _summary(
+        [
+            {
+                "a": 0.5,
+                "H": 2,
+                "method": "mc",
+                "weighting": "uniform",
+                "P": p,
+                "closed_form": 1.0 / p,
+                "closed_kind": "exact",
+                "z": z if p == 10 else 0.1,
+            }
+            for p in (10, 100, 1000)
+        ]
+    )
+
+
+@pytest.mark.parametrize(
+    "fits, z, verdict",
+    [
+        ([(-1.0, -1.05, -0.95), (-0.99, -1.02, -0.96)], 1.0, "supported"),
+        ([(-1.0, -1.05, -0.95), (-0.5, -1.2, 0.01)], 1.0, "not supported"),  # reaches 0
+        ([(-1.0, -1.05, -0.95), (-0.99, -1.02, -0.96)], 3.0, "not supported"),  # |z| > 2.39
+        ([(-1.0, -1.05, -0.95), (-0.8, -0.85, -0.75)], 1.0, "inconclusive"),  # misses -1
+    ],
+)
+def test_dec2_rule_edges(fits, z, verdict):
+    c = _claim(_mc_summary(z), _scaling("mc", fits), "DEC-2")
+    assert c.verdict == verdict
+    # the key number is the flattest slope (the CI that reaches highest), null 0
+    flat = max(fits, key=lambda f: f[2])
+    assert (c.key.value, c.key.ci_low, c.key.ci_high) == flat
+    assert c.key.null == 0.0 and c.key.reproducible == "bitwise"
+
+
+def _pruned_summary() -> pd.DataFrame:
+    rows = [
+        {"a": 0.5, "H": h, "method": "pruned", "weighting": "uniform", "N": 10, "M": m, "P": m}
+        for h in (2, 3, 4)
+        for m in (10, 30, 100)
+    ]
+    return _summary(
+        [
+            *rows,
+            {
+                "a": 0.5,
+                "H": 9,
+                "method": "pruned",
+                "weighting": "uniform",
+                "N": 10,
+                "M": 10,
+                "P": 10,
+            },
+        ]
+    )
+
+
+@pytest.mark.parametrize(
+    "fits, verdict",
+    [
+        ([(-0.5, -0.6, -0.4), (-0.3, -0.5, -0.01)], "supported"),
+        ([(0.1, -0.05, 0.25), (-0.01, -0.07, 0.05)], "not supported"),  # flat: all above -0.1
+        ([(-0.5, -0.6, -0.4), (0.0, -0.05, 0.05)], "inconclusive"),  # one falls, one flat
+        ([(0.1, -0.05, 0.25), (-0.1, -0.3, 0.1)], "inconclusive"),  # a fall still admitted
+    ],
+)
+def test_dec4_rule_edges(fits, verdict):
+    c = _claim(_pruned_summary(), _scaling("pruned", fits), "DEC-4")
+    assert c.verdict == verdict
+    assert f"above −{-dec.PRUNED_FLAT:g}" in c.rule  # the rule states the constant it uses
+    steep = min(fits, key=lambda f: f[1])
+    assert (c.key.value, c.key.ci_low, c.key.ci_high) == steep
+    # the (a, H) cells without a slope are named as left out
+    assert "(a = 0.5, H = 9)" in c.dropped and "no slope" in c.dropped
+
+
+def test_dec5_rule_needs_weighting_to_beat_uniform():
+    def summary(H: int, z: float) -> pd.DataFrame:
+        return _summary(
+            [
+                {
+                    "a": 0.5,
+                    "H": H,
+                    "method": "mc",
+                    "weighting": "likeliness",
+                    "P": p,
+                    "closed_form": 1.0 / p,
+                    "closed_kind": "asymptotic",
+                    "z": z,
+                }
+                for p in (10, 100, 1000)
+            ]
+        )
+
+    ok = _claim(summary(6, 1.0), _scaling("mc", [])[:0], "DEC-5")
+    assert ok.verdict == "supported"
+    assert "1 cells with P < 100" in ok.dropped  # P = 10 left out, and said so
+    # (4/3)^(8/2)/3 > 1: weighting no longer beats uniform at H = 8
+    assert _claim(summary(8, 1.0), _scaling("mc", [])[:0], "DEC-5").verdict == "not supported"
+    # P = 10 does not count: a huge z there changes nothing
+    s = summary(6, 1.0)
+    s.loc[s.P == 10, "z"] = 50.0
+    assert _claim(s, _scaling("mc", [])[:0], "DEC-5").verdict == "supported"
+    s.loc[s.P == 100, "z"] = 5.0
+    assert _claim(s, _scaling("mc", [])[:0], "DEC-5").verdict == "not supported"
+
+
+# ------------------------------------------------------------ section, tables, figure
+
+NAN_INF = re.compile(r"\b(nan|inf)\b", re.IGNORECASE)
+WHOLE_FLOAT_CELL = re.compile(r"\|\s*[+-]?\d+\.0\s*\|")
+CFG = {"replicates": 400, "a_values": [0.4, 0.6], "H_values": [2, 4], "pruned_N": 10}
+
+
+def _section():
+    df = _synthetic(nbo_regret=0.0, pruned_slope=0.0)
+    summary = dec.summarize_lqg_regret(df, MODEL)
+    scaling = dec.lqg_scaling(summary)
+    tables = dec.lqg_tables(summary, scaling)
+    return summary, tables, dec.lqg_decision_section(summary, scaling, tables, MODEL, CFG)
+
+
+def test_section_budget_and_text():
+    _, tables, section = _section()
+    assert len(section.body.encode("utf-8")) <= 2600
+    assert [c.id for c in section.claims] == ["DEC-1", "DEC-2", "DEC-3", "DEC-4"]
+    assert section.figures == list(dec.LQG_FIGURES)
+    for name in section.figures:
+        assert f"](figures/{name}.png)" in section.body
+    assert "### Claims" not in section.body
+    assert not re.search(r"^\|", section.body, re.MULTILINE)  # tables go to the appendix
+    for text in (section.body, section.appendix):
+        assert not NAN_INF.search(text)
+    # configuration values print as written (r = 10, a = 0.4), not 10.0 or 0.400
+    assert "r = 10," in section.body and "0.400" not in section.body
+    assert not re.search(r"(?<![\d.])\d+\.0(?![\d])", section.body)
+    for table in (tables["dec_lqg_regret"], tables["dec_lqg_scaling"]):
+        assert table in section.appendix
+        assert not NAN_INF.search(table) and not WHOLE_FLOAT_CELL.search(table)
+    # absent closed forms are words, explained next to the table
+    assert "| none" in tables["dec_lqg_regret"] and "'none' in the closed-form" in section.appendix
+    assert re.search(r"\|\s+400 \|", tables["dec_lqg_regret"])  # replicates as an integer
+
+
+def test_claims_fit_the_ledger():
+    _, _, section = _section()
+    for c in section.claims:
+        assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300
+        assert c.rule == dec.LQG_RULES[c.id]
+        assert c.key.reproducible == "bitwise"
+        for text in (c.claim, c.paper, c.key.text(), c.measured, c.dropped):
+            assert not NAN_INF.search(text)
+    for rule in dec.LQG_RULES.values():
+        assert len(rule) <= 300
+
+
+def test_figure_colours_are_the_palette():
+    summary, _, _ = _section()
+    fig = figs.lqg_regret_figure(summary)
+    try:
+        seen = set()
+        for ax in fig.axes:
+            assert ax.get_xscale() == ax.get_yscale() == "log"
+            for line in ax.lines:
+                gid = line.get_gid()
+                if gid:
+                    method = gid.split("/")[0]
+                    assert to_hex(line.get_color()) == method_colour(method), gid
+                    seen.add(gid)
+        assert {"mc/uniform", "tree/uniform", "pruned/uniform", "mc/closed form"} <= seen
+        assert not any(g.startswith(("nbo", "antithetic", "cubature")) for g in seen)
+        assert "regret" in fig.axes[0].get_ylabel() and "(count)" in fig.axes[-1].get_xlabel()
+    finally:
+        plt.close(fig)
+
+
+def test_summary_z_scores_and_j_star():
     df = _synthetic(nbo_regret=0.0, pruned_slope=0.0)
     summary = dec.summarize_lqg_regret(df, MODEL)
     exact = summary[summary.closed_kind == "exact"]
@@ -356,15 +617,3 @@ def test_summary_z_scores_and_tables():
     assert summary.loc[(summary.a == 0.4) & (summary.H == 2), "J_star"].iloc[0] == pytest.approx(
         j_star
     )
-    tables = dec.lqg_tables(summary, dec.lqg_scaling(summary))
-    assert "nan" not in tables["dec_lqg_regret"]
-    section = dec.lqg_decision_section(
-        summary,
-        dec.lqg_scaling(summary),
-        tables,
-        MODEL,
-        {"replicates": 400, "a_values": [0.4, 0.6], "H_values": [2, 4]},
-    )
-    assert [c.id for c in section.claims] == ["DEC-1", "DEC-2", "DEC-3", "DEC-4"]
-    for rule in dec.LQG_RULES.values():
-        assert rule in section.body

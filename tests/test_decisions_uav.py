@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import copy
 import dataclasses
+import re
 from pathlib import Path
 
+import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
 import pytest
 import yaml
+from matplotlib.colors import to_hex
 
 from rsmhp.analysis import decisions as dec
 from rsmhp.experiments.decisions_uav import (
@@ -22,6 +25,8 @@ from rsmhp.experiments.decisions_uav import (
     run_map_cell,
     score_state,
 )
+from rsmhp.figures import decisions as figs
+from rsmhp.palette import method_colour
 from rsmhp.uav.simulation import UAVSetup, draw_scenario, method_specs, simulate_run
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -147,36 +152,71 @@ def _map_runs(shift: float) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
+MAP_CFG = {"rows": {"key": "sensor.footprint_radius"}, "cols": {"key": "target.q"}}
+EMPTY_REGRET = pd.DataFrame(columns=REGRET_COLUMNS).astype({"model": str})
+EMPTY_SUMMARY = pd.DataFrame(columns=dec.UAV_SUMMARY_COLUMNS).astype({"method": str})
+
+
+def _map_claims(runs: pd.DataFrame) -> dict:
+    m = dec.summarize_map(runs, pd.DataFrame(columns=REGRET_COLUMNS), MAP_CFG, 1, 500)
+    groups = dec.summarize_map_groups(runs, m, 1, 500)
+    claims = dec.uav_claims(EMPTY_REGRET, EMPTY_SUMMARY, m, groups, 1, 500)
+    return m, groups, {c.id: c for c in claims}
+
+
 @pytest.mark.parametrize(
     "shift, verdict", [(-2.0, "supported"), (2.0, "not supported"), (0.0, "inconclusive")]
 )
 def test_map_claim_rule(shift, verdict):
-    cfg = {"rows": {"key": "sensor.footprint_radius"}, "cols": {"key": "target.q"}}
-    empty = pd.DataFrame(columns=REGRET_COLUMNS)
-    m = dec.summarize_map(_map_runs(shift), empty, cfg, 1, 500)
+    m, groups, claims = _map_claims(_map_runs(shift))
     assert len(m) == 2 and (m["n_runs"] == 40).all()
     if shift:
         assert ((m["mean_diff"] - shift).abs() < 0.3).all()
-    claims = dec.uav_claims(
-        empty.astype({"model": str}),
-        pd.DataFrame(columns=dec.UAV_SUMMARY_COLUMNS).astype({"method": str}),
-        m,
-        1,
-        500,
-    )
-    v = {c.id: c.verdict for c in claims}
-    assert v["DEC-8a"] == verdict  # the footprint cell
-    assert v["DEC-8b"] == verdict  # the unlimited cell
+    assert claims["DEC-8a"].verdict == verdict  # the footprint cell
+    assert claims["DEC-8b"].verdict == verdict  # the unlimited cell
+    for cid, limited in (("DEC-8a", True), ("DEC-8b", False)):
+        key = claims[cid].key
+        g = groups[groups["limited"] == limited].iloc[0]
+        assert key.reproducible == "statistical" and key.null == 0.0 and key.unit == "m"
+        assert (key.value, key.ci_low, key.ci_high) == (g["mean_diff"], g["ci_low"], g["ci_high"])
+        assert key.ci_low <= key.value <= key.ci_high
+        assert not claims[cid].dropped  # one comparison only: nothing left out
 
 
-def test_regret_summary_and_claims():
-    rng = np.random.default_rng(2)
+def test_map_group_needs_every_cell():
+    """One footprint cell clearly better, another no different: the group's mean is
+    significantly below 0, but not every cell is, so the verdict is inconclusive."""
+    runs = pd.concat([_map_runs(-2.0), _map_runs(0.0).assign(cell=lambda d: d["cell"] + "x")])
+    runs.loc[runs["cell"] == "r0c0x", "row_value"] = 120.0  # a second limited cell
+    runs = runs[runs["cell"] != "r1c0x"]
+    _, groups, claims = _map_claims(runs)
+    g = groups[groups["limited"]].iloc[0]
+    assert g["n_cells"] == 2 and g["n_below"] == 1 and g["ci_high"] < 0
+    assert claims["DEC-8a"].verdict == "inconclusive"
+    # the group mean is the mean over cells of the per-run differences
+    d = [dec._paired_errors(runs, c, "rsmhp_nt100") for c in ("r1c0", "r0c0x")]
+    assert g["mean_diff"] == pytest.approx(float(pd.concat(d, axis=1).mean(axis=1).mean()))
+
+
+def test_map_group_drops_other_comparisons_by_name():
+    runs = _map_runs(-2.0)
+    extra = runs[runs["method"] == "rsmhp_nt100"].assign(method="rsmhp_nt250")
+    _, groups, claims = _map_claims(pd.concat([runs, extra]))
+    assert set(groups["comparison"]) == {"rsmhp_nt100 − nbo", "rsmhp_nt250 − nbo"}
+    assert "rsmhp_nt250" in claims["DEC-8a"].dropped  # the first N_T is the evidence
+    assert "N_T=100" in claims["DEC-8a"].claim
+
+
+def _regret_rows(spec: dict, n_runs: int = 10, seed: int = 2) -> pd.DataFrame:
+    """Synthetic regret rows: ``spec[model] = (nbo mean, RS-MHP mean, sd)`` of the relative
+    regret, drawn independently per belief state (10 runs x 2 steps)."""
+    rng = np.random.default_rng(seed)
     rows = []
-    for model, nbo_reg in (("paper", 0.001), ("fp150", 0.05)):
-        for run in range(10):
+    for model, (nbo_reg, rs_reg, sd) in spec.items():
+        for run in range(n_runs):
             for step in (0, 5):
-                for method, reg in (("nbo", nbo_reg), ("rsmhp_nt100", 0.001)):
-                    rel = abs(rng.normal(reg, reg / 5))
+                for method, reg in (("nbo", nbo_reg), ("rsmhp_nt100", rs_reg)):
+                    rel = abs(rng.normal(reg, sd))
                     rows.append(
                         {
                             "model": model,
@@ -196,17 +236,176 @@ def test_regret_summary_and_claims():
                             "regret_se": 1e-4,
                             "regret_rel": rel,
                             "regret_methods": rel,
-                            "spearman_random": 0.9,
+                            "spearman_random": 0.9
+                            if method != "nbo" or model == "paper"
+                            else np.nan,
                             "spearman_local": 0.8,
                             "n_eval": 4000,
                         }
                     )
-    df = pd.DataFrame(rows, columns=REGRET_COLUMNS)
+    return pd.DataFrame(rows, columns=REGRET_COLUMNS)
+
+
+def _regret_claims(spec: dict) -> dict:
+    df = _regret_rows(spec)
+    summary = dec.summarize_uav_regret(df, 1, 500)
+    empty = pd.DataFrame(columns=dec.MAP_GROUP_COLUMNS)
+    claims = dec.uav_claims(df, summary, pd.DataFrame(), empty, 1, 500)
+    return {c.id: c for c in claims}
+
+
+def test_regret_summary_and_claims():
+    df = _regret_rows({"paper": (0.001, 0.001, 0.0002), "fp150": (0.05, 0.001, 0.01)})
     summary = dec.summarize_uav_regret(df, 1, 500)
     assert len(summary) == 4 and (summary["n_states"] == 20).all()
-    v = {c.id: c.verdict for c in dec.uav_claims(df, summary, pd.DataFrame(), 1, 500)}
-    assert v["DEC-6"] == "supported"  # NBO within the margin of RS-MHP in the reconstruction
-    assert v["DEC-7-fp150"] == "supported"  # RS-MHP decides better with the footprint
+    # NBO's cost constant at every fp150 state: the correlation is undefined and counted
+    fp = summary[(summary.model == "fp150") & (summary.method == "nbo")].iloc[0]
+    assert np.isnan(fp["spearman_random"]) and fp["spearman_random_undefined"] == 20
+    c = _regret_claims({"paper": (0.001, 0.001, 0.0002), "fp150": (0.05, 0.001, 0.01)})
+    assert c["DEC-6"].verdict == "supported"  # NBO within the margin of RS-MHP
+    assert c["DEC-7-fp150"].verdict == "supported"  # RS-MHP decides better with the footprint
+    k6, k7 = c["DEC-6"].key, c["DEC-7-fp150"].key
+    assert k6.unit == k7.unit == "pp" and k6.reproducible == k7.reproducible == "statistical"
+    assert k6.null is None  # an equivalence claim has no single opposite value
+    assert k7.null == 0.0
+    g = df[df.model == "fp150"].pivot_table(
+        index=["run", "step"], columns="method", values="regret_rel"
+    )
+    d = g["nbo"] - g["rsmhp_nt100"]
+    assert k7.value == pytest.approx(100 * d.mean())  # percentage points
+    assert k7.ci_low < k7.value < k7.ci_high
+
+
+@pytest.mark.parametrize(
+    "nbo, rs, sd, verdict",
+    [
+        (0.010, 0.010, 0.0005, "supported"),  # equal: CI well inside ±0.5 pp
+        (0.030, 0.010, 0.0005, "not supported"),  # 2 pp apart: CI outside the margin
+        (0.015, 0.010, 0.0020, "inconclusive"),  # 0.5 pp apart: CI straddles the margin
+        (0.010, 0.030, 0.0005, "not supported"),  # NBO better by 2 pp: also not equivalent
+    ],
+)
+def test_dec6_equivalence_rule(nbo, rs, sd, verdict):
+    c = _regret_claims({"paper": (nbo, rs, sd)})["DEC-6"]
+    assert c.verdict == verdict
+    margin = 100 * dec.EQUIVALENCE_MARGIN
+    inside = -margin < c.key.ci_low and c.key.ci_high < margin
+    assert inside == (verdict == "supported")
+    assert f"±{100 * dec.EQUIVALENCE_MARGIN:g} percentage points" in c.rule  # rule = constant
+
+
+@pytest.mark.parametrize(
+    "nbo, rs, verdict",
+    [(0.03, 0.01, "supported"), (0.01, 0.03, "not supported"), (0.01, 0.01, "inconclusive")],
+)
+def test_dec7_sign_rule(nbo, rs, verdict):
+    c = _regret_claims({"paper": (0.01, 0.01, 0.001), "fp": (nbo, rs, 0.002)})["DEC-7-fp"]
+    assert c.verdict == verdict
+
+
+NAN_INF = re.compile(r"\b(nan|inf)\b", re.IGNORECASE)
+WHOLE_FLOAT_CELL = re.compile(r"\|\s*[+-]?\d+\.0\s*\|")
+SECTION_CFG = {
+    "uav": {
+        "runs": 10,
+        "steps": [0, 5],
+        "n_eval": 300,
+        "polish": 1,
+        "random_starts": 1,
+        "eval_maxiter": 15,
+        "n_random": 30,
+        "models": [{"name": "paper"}, {"name": "fp150", "sensor": {"footprint_radius": 150.0}}],
+    },
+    "map": {
+        "rows": {"key": "sensor.footprint_radius", "values": [None, 150.0]},
+        "cols": {"key": "target.q", "values": [1.0]},
+        "runs": 40,
+        "bootstrap": 500,
+        "track_loss_error": 50.0,
+        "regret_runs": 1,
+        "regret_steps": [0],
+    },
+}
+
+
+def _section():
+    regret = _regret_rows({"paper": (0.001, 0.001, 0.0002), "fp150": (0.05, 0.001, 0.01)})
+    summary = dec.summarize_uav_regret(regret, 1, 500)
+    runs = _map_runs(-2.0)
+    m = dec.summarize_map(runs, pd.DataFrame(columns=REGRET_COLUMNS), MAP_CFG, 1, 500)
+    groups = dec.summarize_map_groups(runs, m, 1, 500)
+    tables = dec.uav_tables(summary, m)
+    section = dec.uav_decision_section(regret, summary, m, groups, tables, SECTION_CFG, 1)
+    return regret, m, tables, section
+
+
+def test_section_budget_and_text():
+    _, _, tables, section = _section()
+    assert len(section.body.encode("utf-8")) <= 2600
+    assert [c.id for c in section.claims] == ["DEC-6", "DEC-7-fp150", "DEC-8a", "DEC-8b"]
+    for name in dec.UAV_FIGURES:
+        assert f"](figures/{name}.png)" in section.body
+    assert not re.search(r"^\|", section.body, re.MULTILINE)  # tables go to the appendix
+    for word in ("Relative regret", "percentage points", "N_T", "footprint", "track loss"):
+        assert word.lower() in section.body.lower()
+    for text in (section.body, section.appendix):
+        assert not NAN_INF.search(text)
+    assert not re.search(r"(?<![\d.])\d+\.0(?![\d])", section.body)
+    assert "{unlimited, 150}" in section.body and "above 50 m" in section.body
+    for table in tables.values():
+        assert table in section.appendix
+        assert not NAN_INF.search(table) and not WHOLE_FLOAT_CELL.search(table)
+    # the unlimited footprint and the undefined values are words, explained in the appendix
+    assert "| unlimited" in tables["dec_uav_map"] and "'unlimited'" in section.appendix
+    assert "undefined" in tables["dec_uav_regret"]  # NBO's constant cost in fp150
+    assert "undefined" in tables["dec_uav_map"]  # no open-loop regret states in these cells
+    assert re.search(r"\|\s+40 \|", tables["dec_uav_map"])  # runs as an integer
+
+
+def test_claims_fit_the_ledger():
+    _, _, _, section = _section()
+    rules = {"DEC-6": "DEC-6", "DEC-7-fp150": "DEC-7", "DEC-8a": "DEC-8", "DEC-8b": "DEC-8"}
+    for c in section.claims:
+        assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300, c.id
+        assert c.rule == dec.UAV_RULES[rules[c.id]]
+        assert c.key.reproducible == "statistical" and c.key.has_ci
+        for text in (c.claim, c.paper, c.key.text(), c.measured, c.dropped):
+            assert not NAN_INF.search(text)
+
+
+def test_axis_values_in_words():
+    assert dec.axis_value("sensor.footprint_radius", None) == "unlimited"
+    assert dec.axis_value("sensor.footprint_radius", float("nan")) == "unlimited"
+    assert dec.axis_value("sensor.footprint_radius", 150.0) == "150"
+    assert dec.axis_value("target.q", 0.25) == "0.25"
+    assert dec.axis_label("target.q") == "target manoeuvrability q (m²/s³)"
+
+
+def test_figures_use_the_palette_and_label_units():
+    regret, m, _, _ = _section()
+    fig = figs.uav_regret_figure(regret)
+    try:
+        seen = set()
+        for ax in fig.axes:
+            assert ax.get_yscale() == "log" and "(%" in ax.get_ylabel()
+            assert "drawn at" in ax.get_title()  # the floor's clipping is counted
+            for coll in ax.collections:
+                if coll.get_gid():
+                    assert to_hex(coll.get_facecolor()[0]) == method_colour(coll.get_gid())
+                    seen.add(coll.get_gid())
+        assert seen == {"nbo", "rsmhp_nt100"}
+    finally:
+        plt.close(fig)
+    fig = figs.uav_map_figure(m)
+    try:
+        labels = [ax.get_ylabel() for ax in fig.axes]
+        assert any("mean paired difference" in lab and "(m)" in lab for lab in labels)
+        heat = fig.axes[0]
+        assert heat.get_ylabel() == "footprint radius (m)"
+        assert "unlimited" in [t.get_text() for t in heat.get_yticklabels()]
+        assert heat.get_xlabel() == "target manoeuvrability q (m²/s³)"
+    finally:
+        plt.close(fig)
 
 
 def test_limited_cells_follow_the_axis_else_the_base_sensor():

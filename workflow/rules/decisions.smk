@@ -1,6 +1,7 @@
 # Decision-quality study: the regret of the controls each method chooses.
 # Simulation, aggregation and figures are separate rules; the sensitivity map runs one job
 # per cell (wildcard {cell} = r<i>c<j>), so a cell reruns alone and cells fan out.
+from rsmhp.analysis.decisions import LQG_FIGURES, UAV_FIGURES
 from rsmhp.experiments.decisions_uav import map_cells
 
 DEC = config["decisions"]
@@ -9,7 +10,7 @@ MAP_CELLS = [c.name for c in map_cells(DEC["map"])]
 DEC_SCORING = pick(
     DEC["uav"], "n_eval", "polish", "random_starts", "eval_maxiter", "n_random"
 )
-DEC_FIGURES = ["dec_lqg_regret", "dec_uav_regret", "dec_uav_map"]
+DEC_FIGURES = [*LQG_FIGURES, *UAV_FIGURES]
 DEC_REC = DEC["recording"]
 DEC_RECORDING = f"results/recordings/dec_{DEC_REC['model']}_run{DEC_REC['run']}.rrd"
 REPORT_SECTIONS["decisions_lqg"] = "results/report/decisions_lqg.json"
@@ -133,6 +134,7 @@ rule decisions_uav_summary:
     output:
         regret_summary="results/decisions/uav_regret_summary.csv",
         map="results/decisions/uav_map.csv",
+        map_groups="results/decisions/uav_map_groups.csv",
         tables=table_outputs(["dec_uav_regret", "dec_uav_map"], "Decision study"),
         section="results/report/decisions_uav.json",
     log:

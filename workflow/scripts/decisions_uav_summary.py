@@ -29,12 +29,14 @@ with rule_logging(snakemake.log[0], snakemake.rule):
     )
     summary = analysis.summarize_uav_regret(regret, seed, n_boot)
     map_df = analysis.summarize_map(map_runs, map_regret, cfg["map"], seed, n_boot)
+    groups = analysis.summarize_map_groups(
+        map_runs, map_df, seed, n_boot, snakemake.params.base_limited
+    )
     tables = analysis.uav_tables(summary, map_df)
     write_csv(summary, snakemake.output.regret_summary)
     write_csv(map_df, snakemake.output.map)
+    write_csv(groups, snakemake.output.map_groups)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
-    section = analysis.uav_decision_section(
-        regret, summary, map_df, tables, cfg, seed, snakemake.params.base_limited
-    )
+    section = analysis.uav_decision_section(regret, summary, map_df, groups, tables, cfg, seed)
     section.save(snakemake.output.section)
