@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 import pytest
@@ -45,7 +47,7 @@ CFG = {
         "nbo",
     ],
     "budgets": [16, 64],
-    "tree_N": [2, 4, 8, 16],
+    "tree_N": [2, 3, 4, 6, 8, 16],
     "max_leaves": 64,
     "pruning": {"N": [4, 16], "M": [1, 2, 8]},
 }
@@ -74,8 +76,8 @@ def test_ncv_problem_matches_its_definition():
 def test_grid_respects_leaf_cap_and_m_le_n(problems):
     pts = grid_points(CFG, problems)
     trees = [p for p in pts if p.scheme == "tree"]
-    # lqg_paper (H=2): N^2 <= 64 -> N in {2, 4, 8}; ncv2 (H=2) the same
-    assert sorted({p.N for p in trees}) == [2, 4, 8]
+    # lqg_paper (H=2): N^2 <= 64 -> N in {2, 3, 4, 6, 8} (16 is over the cap); ncv2 the same
+    assert sorted({p.N for p in trees}) == [2, 3, 4, 6, 8]
     assert all(p.M <= p.N for p in pts if p.scheme == "pruned")
     assert GridPoint("lqg_paper", "pruned", N=4, M=8) not in pts
     # Gauss-Hermite: q^D <= n with D = 2 (scalar) and D = 8 (ncv2: only q <= 1 fits -> none)
@@ -96,7 +98,7 @@ def test_ablation_table(ablation, problems):
         nbo = sub[sub["scheme"] == "nbo"]
         np.testing.assert_allclose(nbo["estimate"], prob.nbo_cost(), rtol=1e-12)
     tree = ablation[(ablation["scheme"] == "tree") & (ablation["problem"] == "lqg_paper")]
-    assert set(tree["n_trajectories"]) == {4, 16, 64}
+    assert set(tree["n_trajectories"]) == {4, 9, 16, 36, 64}
     pruned = ablation[ablation["scheme"] == "pruned"]
     assert (pruned["n_trajectories"] == pruned["M"]).all()
     # uniform and weighted rows of a replicate come from one sample: same CPU time
@@ -137,34 +139,276 @@ def test_summary_matches_raw_rows_and_theory(ablation, problems):
     assert np.allclose(w["limit"], qf.weighted_limit())
 
 
-def test_verdicts_follow_the_data(ablation, problems):
-    s = analysis.summarize_ablation(ablation, problems, seed=11)
+@pytest.fixture(scope="module")
+def summary(ablation, problems) -> pd.DataFrame:
+    return analysis.summarize_ablation(ablation, problems, seed=11)
+
+
+def test_verdicts_follow_the_data(ablation, summary):
+    s = summary
     claims, facts = analysis.claims(ablation, s, [2.0])
     by_id = {c.id: c for c in claims}
-    # weighted tree estimates sit near J(Σ/2), far from J: Prop. 2 is rejected
+    assert list(by_id) == ["EST-1", "EST-2", "EST-3", "EST-4"]
+    # every key number of this study is bitwise reproducible (seeded draws and bootstrap)
+    assert all(c.key.reproducible == "bitwise" for c in claims)
+    # weighted tree estimates move to J(Σ/2), far from J: Prop. 2 is rejected
     assert by_id["EST-2"].verdict == "not supported"
+    assert by_id["EST-2"].key.ci_low > 0.5 and by_id["EST-2"].key.null == 1.0
     # pruned estimates approach NBO at N = 16
     assert by_id["EST-4"].verdict == "not supported"
     # a fake table in which the pruned estimator is exact must flip EST-4 to supported
     fake = s.copy()
     pr = fake["scheme"] == "pruned"
-    for col in ("bias_fraction_of_nbo", "bias_fraction_low", "bias_fraction_high"):
-        fake.loc[pr, col] = {
-            "bias_fraction_of_nbo": 0.0,
-            "bias_fraction_low": -0.01,
-            "bias_fraction_high": 0.01,
-        }[col]
-    assert {c.id: c for c in analysis.claims(ablation, fake, [2.0])[0]}[
-        "EST-4"
-    ].verdict == "supported"
+    fake.loc[pr, "bias_fraction_of_nbo"] = 0.0
+    fake.loc[pr, "bias_fraction_low"] = -0.01
+    fake.loc[pr, "bias_fraction_high"] = 0.01
+    assert analysis.claim_est4(fake)[0].verdict == "supported"
     # a tree whose variance grows with N contradicts Prop. 1
     bad = s.copy()
     tree = (bad["scheme"] == "tree") & (bad["weighting"] == "uniform")
     bad.loc[tree, "var"] = bad.loc[tree, "N"] * 100.0
-    assert {c.id: c for c in analysis.claims(ablation, bad, [2.0])[0]}["EST-1"].verdict == (
-        "not supported"
-    )
+    bad.loc[tree, "var_low"] = bad.loc[tree, "var"] * 0.9
+    bad.loc[tree, "var_high"] = bad.loc[tree, "var"] * 1.1
+    assert analysis.claim_est1(bad)[0].verdict == "not supported"
     assert set(facts) >= {"tree_vs_independent", "chebyshev", "pruning_at_max_N"}
+
+
+# --- verdict rules on synthetic summaries with known answers ------------------------------
+
+
+def _tree_rows(problem: str, var_by_n: dict[int, float], H: int = 2, rel: float = 0.1) -> list:
+    """Uniform shared-tree cells with the given variances (CI ± rel, derived value inside)."""
+    return [
+        {
+            "problem": problem,
+            "scheme": "tree",
+            "weighting": "uniform",
+            "N": N,
+            "M": 0,
+            "H": H,
+            "n_trajectories": N**H,
+            "var": v,
+            "var_low": v * (1 - rel),
+            "var_high": v * (1 + rel),
+            "var_theory": v,
+        }
+        for N, v in var_by_n.items()
+    ]
+
+
+CLEAN = {N: 100.0 / N for N in (2, 3, 4, 6, 8)}
+#: five sizes, no trend: the slope's CI straddles 0
+FLAT = {2: 100.0, 3: 40.0, 4: 90.0, 6: 45.0, 8: 95.0}
+
+
+def test_est1_supported_only_when_every_counted_slope_ci_is_below_zero():
+    s = pd.DataFrame(_tree_rows("a", CLEAN) + _tree_rows("b", {N: 50.0 / N for N in CLEAN}))
+    c, _ = analysis.claim_est1(s)
+    assert c.verdict == "supported"
+    assert c.key.value == pytest.approx(-1.0) and c.key.ci_high < 0 and c.key.null == 0.0
+    # one counted problem whose slope CI admits >= 0: not supported as a whole
+    s = pd.DataFrame(_tree_rows("a", CLEAN) + _tree_rows("flat", FLAT))
+    c, _ = analysis.claim_est1(s)
+    assert c.verdict == "inconclusive"
+    assert "flat" in c.key.name and c.key.ci_low <= 0 <= c.key.ci_high
+    # a significantly rising variance contradicts the claim
+    s = pd.DataFrame(_tree_rows("a", CLEAN) + _tree_rows("up", {N: 10.0 * N for N in CLEAN}))
+    assert analysis.claim_est1(s)[0].verdict == "not supported"
+
+
+def test_est1_names_every_problem_left_out_of_the_slope_evidence():
+    few = {2: 100.0, 3: 40.0, 4: 90.0}  # 3 sizes: 1 degree of freedom
+    s = pd.DataFrame(
+        _tree_rows("a", CLEAN) + _tree_rows("three", few, H=6) + _tree_rows("one", {2: 300.0}, H=8)
+    )
+    c, _ = analysis.claim_est1(s)
+    assert c.verdict == "supported"  # decided by "a" alone, the others named
+    assert "three (H = 6): ran only at N = 2, 3, 4" in c.dropped and "admits 0" in c.dropped
+    assert "one (H = 8): ran only at N = 2" in c.dropped and "no slope" in c.dropped
+    assert "three" not in c.measured.split("variance slope vs N")[1].split(";")[0]
+
+
+def _weighted_rows(problem: str, f_by_n: dict[int, float], half: float = 0.05) -> list:
+    """Weighted shared-tree cells with f = (mean - J)/(J(Σ/2) - J) given, CI f ± half."""
+    j, lim = 20.0, 14.0
+    rows = []
+    for N, f in f_by_n.items():
+        bias = f * (lim - j)
+        rows.append(
+            {
+                "problem": problem,
+                "scheme": "tree",
+                "weighting": "weighted",
+                "N": N,
+                "H": 2,
+                "n_trajectories": N**2,
+                "J_exact": j,
+                "limit": lim,
+                "mean": j + bias,
+                "bias": bias,
+                "bias_low": bias - half * (j - lim),
+                "bias_high": bias + half * (j - lim),
+            }
+        )
+    return rows
+
+
+def test_est2_rule_edge_cases():
+    growing = {2: 0.6, 3: 0.8, 4: 0.9, 8: 1.0}
+    c = analysis.claim_est2(pd.DataFrame(_weighted_rows("p", growing)))
+    assert c.verdict == "not supported"
+    assert c.key.value == pytest.approx(1.0) and "N = 8" in c.key.name
+    # at J everywhere (CI contains 0 and excludes 1): supported
+    at_j = {N: 0.0 for N in growing}
+    c = analysis.claim_est2(pd.DataFrame(_weighted_rows("p", at_j)))
+    assert c.verdict == "supported" and c.key.ci_high < 1.0
+    # a bias that shrinks toward J with N is not evidence against convergence to J
+    shrinking = {2: 0.8, 3: 0.6, 4: 0.4, 8: 0.2}
+    assert analysis.claim_est2(pd.DataFrame(_weighted_rows("p", shrinking))).verdict == (
+        "inconclusive"
+    )
+    # too few sizes cannot decide "not supported"; the problem is named
+    c = analysis.claim_est2(pd.DataFrame(_weighted_rows("short", {2: 0.5})))
+    assert c.verdict == "inconclusive" and "short (1 tree size(s))" in c.dropped
+
+
+def _gain_rows() -> pd.DataFrame:
+    rows = []
+    for scheme, weighting, pts in (
+        ("mc", "uniform", [(64, 2e-4, 2.0)]),
+        ("sobol", "uniform", [(64, 1.5e-4, 0.5)]),
+        ("cubature", "quadrature", [(4, 1e-4, 3.6e-15)]),
+        ("gauss_hermite", "quadrature", [(16, 1e-4, 0.0)]),
+    ):
+        for n, cpu, rmse in pts:
+            rows.append(
+                {
+                    "problem": "p",
+                    "scheme": scheme,
+                    "weighting": weighting,
+                    "n_trajectories": n,
+                    "cpu_median": cpu,
+                    "rmse": rmse,
+                    "J_exact": 18.9,
+                }
+            )
+    return pd.DataFrame(rows)
+
+
+def test_exact_schemes_are_not_reported_as_gains():
+    g = analysis.equal_cpu_gains(_gain_rows()).set_index("scheme")
+    assert g.loc["cubature", "exact"] and g.loc["gauss_hermite", "exact"]
+    assert np.isnan(g.loc["cubature", "gain_vs_mc"]) and np.isnan(
+        g.loc["gauss_hermite", "gain_vs_mc"]
+    )
+    assert g.loc["sobol", "gain_vs_mc"] == pytest.approx(4.0) and not g.loc["sobol", "exact"]
+    text = analysis.gain_table(_gain_rows())
+    assert text.count("exact (error at rounding level)") == 2
+    assert "e+" not in text and "inf" not in text.lower() and "nan" not in text.lower()
+
+
+# --- the report section ------------------------------------------------------------------
+
+NAN_INF = re.compile(r"\b(nan|inf)\b", re.IGNORECASE)
+#: a number that ends in ".0" (e.g. "200.0"), never how an integer should print
+DOT_ZERO = re.compile(r"(?<![\d.])\d+\.0(?![\d])")
+
+
+def _table_cells(md: str) -> list[dict[str, str]]:
+    lines = [ln for ln in md.splitlines() if ln.startswith("|")]
+    head = [c.strip() for c in lines[0].strip("|").split("|")]
+    return [
+        dict(zip(head, (c.strip() for c in ln.strip("|").split("|")), strict=True))
+        for ln in lines[2:]
+    ]
+
+
+@pytest.fixture(scope="module")
+def section(ablation, summary):
+    tabs = analysis.tables(ablation, summary, [1.5, 2.0, 3.0])
+    return analysis.estimators_section(ablation, summary, [1.5, 2.0, 3.0], tabs), tabs
+
+
+def test_section_body_budget_and_clean_numbers(section):
+    sec, tabs = section
+    assert len(sec.body.encode("utf-8")) <= 3000
+    assert "|" not in sec.body  # tables live in the appendix
+    for name in analysis.FIGURES:
+        assert f"(figures/{name}.png)" in sec.body
+    assert sec.figures == [f"{n}.png" for n in analysis.FIGURES]
+    texts = [sec.body, sec.appendix] + [
+        x
+        for c in sec.claims
+        for x in (c.claim, c.paper, c.rule, c.measured, c.dropped, c.key.text())
+    ]
+    for text in texts:
+        assert not NAN_INF.search(text), NAN_INF.search(text)
+    # integer-valued quantities print without ".0": sizes in prose, rules and integer columns
+    for text in [sec.body, *(c.rule for c in sec.claims), *(c.dropped for c in sec.claims)]:
+        assert not DOT_ZERO.search(text), DOT_ZERO.search(text)
+    assert "k in {1.5, 2, 3}" in sec.claims[2].rule
+    for c in sec.claims:
+        assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300
+    integer_cols = {"n", "N", "M", "H", "leaves", "n reached"}
+    for stem, md in tabs.items():
+        for row in _table_cells(md):
+            for col in integer_cols & set(row):
+                assert re.fullmatch(r"\d+|—", row[col]), (stem, col, row[col])
+    # symbols are defined in the body where first used
+    for term in ("tree_pernode", "pruned", "S = I_H ⊗ Σ", "g(w) = c + bᵀw + wᵀKw", "J(Σ/2) = "):
+        assert term in sec.body
+
+
+def test_figures_use_the_palette(summary, problems):
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import to_hex
+
+    from rsmhp.figures import estimators as figs
+    from rsmhp.palette import LINESTYLES, method_colour, method_label
+
+    labels = {
+        method_label(m): m for m in ("mc", "antithetic", "sobol", "tree", "tree_pernode", "pruned")
+    }
+
+    def check(fig, min_lines: int) -> None:
+        n = 0
+        for ax in fig.axes:
+            for cont in ax.containers:
+                line = cont.lines[0]
+                label = cont.get_label()
+                base, weighted = (
+                    label.split(" (N =")[0].removesuffix(", weighted"),
+                    ", weighted" in label,
+                )
+                assert to_hex(line.get_color()) == method_colour(labels[base]), label
+                want = LINESTYLES["weighted"] if weighted else LINESTYLES["measured"]
+                assert line.get_linestyle() == want, label
+                n += 1
+        assert n >= min_lines
+        plt.close(fig)
+
+    for make in (figs.rmse_figure, figs.bias_figure, figs.weighted_vs_uniform_figure):
+        fig = make(summary)
+        assert fig.get_suptitle()
+        panels = [ax for ax in fig.axes if ax.get_visible() and ax.axison]
+        assert all(ax.get_title() and ax.get_xlabel() and ax.get_ylabel() for ax in panels)
+        check(fig, min_lines=4)
+    fig = figs.tree_variance_figure(summary, problems)
+    derived = 0
+    for ax in fig.axes:
+        for line in ax.get_lines():
+            lab = line.get_label()
+            if ": derived" in lab:
+                assert line.get_linestyle() == LINESTYLES["derived"]
+                scheme = labels[lab.split(":")[0]]
+                assert to_hex(line.get_color()) == method_colour(scheme)
+                derived += 1
+    assert derived == 3 * len(problems)  # mc, tree and per-node tree in every panel
+    assert any("cost units²" in ax.get_ylabel() for ax in fig.axes)
+    plt.close(fig)
+    fig = figs.pruning_heatmap(summary)
+    assert any("bias / (J_NBO - J)" in ax.get_ylabel() for ax in fig.axes)  # the colour bar
+    plt.close(fig)
 
 
 def test_equal_cpu_gain_uses_the_pareto_frontier():
@@ -196,3 +440,26 @@ def test_bias_fraction_interval_is_ordered(ablation, problems):
     sampled = s[s["n_replicates"] > 1]
     assert (sampled["bias_fraction_low"] <= sampled["bias_fraction_of_nbo"]).all()
     assert (sampled["bias_fraction_of_nbo"] <= sampled["bias_fraction_high"]).all()
+
+
+def test_every_table_and_figure_is_declared_and_captioned(section):
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    smk = (root / "workflow/rules/estimators.smk").read_text(encoding="utf-8")
+    _, tabs = section
+    for stem in tabs:
+        assert f'"{stem}"' in smk, stem
+        assert (root / f"workflow/report/table_{stem}.rst").read_text(encoding="utf-8").strip()
+    for name in analysis.FIGURES:
+        assert f'"{name}"' in smk, name
+        assert (root / f"workflow/report/{name}.rst").read_text(encoding="utf-8").strip()
+
+
+def test_section_round_trips_through_json(section, tmp_path):
+    from rsmhp.report import Section
+
+    sec, _ = section
+    sec.save(tmp_path / "estimators.json")
+    back = Section.load(tmp_path / "estimators.json")
+    assert back.claims == sec.claims and back.body == sec.body and back.appendix == sec.appendix

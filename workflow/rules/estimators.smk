@@ -8,6 +8,7 @@ EST_TABLES = [
     "est_pruning",
     "est_equal_cpu",
     "est_chebyshev",
+    "est_weighted",
 ]
 EST_FIGURES = [
     "est_rmse_vs_n",
