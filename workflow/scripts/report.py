@@ -28,14 +28,18 @@ with rule_logging(snakemake.log[0], snakemake.rule) as log:
     summary = {k: v for k, v in prov.items() if k not in ("host", "date (UTC)")}
     main = render_report(sections, summary)
     write_text(main, snakemake.output.report)
-    write_text(render_appendix(sections, snakemake.params.config, summary), snakemake.output.appendix)
+    write_text(
+        render_appendix(sections, snakemake.params.config, summary), snakemake.output.appendix
+    )
     records = claims_records(sections)
     claims_file = {
         "config sha256": prov.get("config sha256"),
         "commit": prov.get("commit"),
         "claims": records,
     }
-    write_text(json.dumps(claims_file, indent=1, ensure_ascii=False) + "\n", snakemake.output.claims)
+    write_text(
+        json.dumps(claims_file, indent=1, ensure_ascii=False) + "\n", snakemake.output.claims
+    )
     claims = [c for s in sorted(sections, key=lambda s: (s.order, s.key)) for c in s.claims]
     write_text(glance_table(claims) + "\n", snakemake.output.glance)
     log.info("main text %d bytes, %d claims", len(main.encode()), len(records))
