@@ -241,3 +241,21 @@ def test_published_report_matches_its_claims_and_the_readme():
     assert block.strip() == glance_table(claims).strip()
     for fig in re.findall(r"\]\((figures/[^)]+)\)", main):
         assert (ROOT / "paper" / fig).is_file(), fig
+
+
+def test_every_snakemake_report_caption_is_valid_restructuredtext():
+    """`|x|` is a substitution in reStructuredText: captions must escape it (docutils reports
+    an ERROR and the HTML report shows the error box instead of the caption)."""
+    import io
+
+    import docutils.core
+
+    captions = sorted((ROOT / "workflow/report").glob("*.rst"))
+    assert captions
+    for path in captions:
+        err = io.StringIO()
+        docutils.core.publish_doctree(
+            path.read_text(encoding="utf-8"),
+            settings_overrides={"warning_stream": err, "report_level": 2},
+        )
+        assert not err.getvalue(), f"{path.name}: {err.getvalue()}"

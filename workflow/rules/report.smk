@@ -33,8 +33,7 @@ rule report:
 
 
 rule verify:
-    """Compare this run's claims, claim by claim, with the committed reference paper/claims.json;
-    fails if a verdict flips or a key number leaves its tolerance."""
+    """Compare this run's claims with the committed paper/claims.json, claim by claim (make verify)."""
     input:
         run="results/paper/claims.json",
         reference="paper/claims.json",
