@@ -85,6 +85,10 @@ def test_markdown_table_integers_digits_and_missing():
     shown = markdown_table(bad, missing="n/a (exact)")
     assert "n/a (exact)" in shown and "nan" not in shown
     assert "+1" in markdown_table(pd.DataFrame({"d": [1.0, -2.0]}), signed=("d",))
+    piped = markdown_table(pd.DataFrame({"key": ["max |z|"], "v": [2.5]}))
+    assert "max \\|z\\|" in piped and all(
+        len(re.findall(r"(?<!\\)\|", row)) == 3 for row in piped.splitlines()
+    )
 
 
 # ---------------------------------------------------------------- claims
@@ -146,7 +150,11 @@ def test_section_roundtrip_and_rendering(tmp_path):
     assert "CI below 0: supported" in main and "| t |" not in main
     app = render_appendix([a, b], {"seed": 2}, prov)
     assert "### Z-1 (inconclusive)" in app and "| t |" in app and "seed: 2" in app
-    assert "statistically reproducible" in app and "- config sha256: `0123`" in app
+    assert (
+        "(statistically reproducible)" in app
+        and "(bitwise reproducible)" in app
+        and "- config sha256: `0123`" in app
+    )
     recs = claims_records([a, b])
     assert [r["id"] for r in recs] == ["A-1", "Z-1"]
     assert Claim.from_dict(json.loads(json.dumps(recs[1]))) == a.claims[0]

@@ -206,7 +206,8 @@ def markdown_table(
     """Markdown table without index. Integer columns (and float columns whose values are all
     whole numbers) print as integers, other floats with ``digits`` significant digits (per
     cell). NaN/inf cells raise ``ValueError`` naming the column unless ``missing`` gives the
-    text to print instead (explain it next to the table); ``signed`` columns get a + sign."""
+    text to print instead (explain it next to the table); ``signed`` columns get a + sign.
+    A ``|`` inside a text cell is escaped (it would end the cell)."""
     out = pd.DataFrame(index=df.index)
     align = []
     for col in df.columns:
@@ -217,7 +218,8 @@ def markdown_table(
             bad = s.isna()
             if bad.any() and missing is None:
                 raise ValueError(f"table column {col!r} has {int(bad.sum())} missing cell(s)")
-            out[col] = s.astype(object).where(~bad, missing).astype(str)
+            cells = s.astype(object).where(~bad, missing).astype(str)
+            out[col] = cells.str.replace("|", "\\|", regex=False)  # a bare | ends the cell
             continue
         x = s.astype(float)
         finite = np.isfinite(x)
@@ -345,6 +347,9 @@ def render_report(
     return "\n".join(parts)
 
 
+_REPRO_TEXT = {"bitwise": "bitwise reproducible", "statistical": "statistically reproducible"}
+
+
 def render_appendix(
     sections: Iterable[Section], config: Mapping[str, Any], provenance: Mapping[str, str]
 ) -> str:
@@ -366,7 +371,7 @@ def render_appendix(
                 "",
                 f"- Claim: {c.claim}",
                 f"- Paper: {c.paper}",
-                f"- Key number: {c.key.text()} ({c.key.reproducible}ly reproducible)",
+                f"- Key number: {c.key.text()} ({_REPRO_TEXT[c.key.reproducible]})",
                 f"- Verdict rule: {c.rule}",
             ]
             if c.measured:
