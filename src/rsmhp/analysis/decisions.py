@@ -55,6 +55,7 @@ import pandas as pd
 from scipy import stats as sps
 
 from rsmhp import lqg
+from rsmhp.analysis.uav import bootstrap_ci
 from rsmhp.palette import method_label
 from rsmhp.report import Claim, KeyNumber, Section, fmt, fmt_ci, markdown_table
 from rsmhp.seeding import job_rng
@@ -779,12 +780,19 @@ def axis_value(key: str, value: Any) -> str:
     return _param(value)
 
 
-def _bootstrap_ci(x: np.ndarray, rng: np.random.Generator, n_boot: int) -> tuple[float, float]:
-    """95% percentile bootstrap CI of the mean of ``x`` (``n_boot`` resamples with
-    replacement; the same arithmetic as :func:`rsmhp.analysis.uav.bootstrap_ci`)."""
-    idx = rng.integers(0, x.size, size=(n_boot, x.size))
-    lo, hi = np.quantile(np.mean(x[idx], axis=1), [0.025, 0.975])
-    return float(lo), float(hi)
+def _regret_key(method: str, m: float, lo: float, hi: float, null: float | None) -> KeyNumber:
+    """Key number of DEC-6/DEC-7: paired mean of NBO's − ``method``'s relative regret (pp)
+    with its bootstrap CI; ``null`` 0 for a difference claim, None for equivalence."""
+    return KeyNumber(
+        f"NBO − {method_label(method)} relative regret, paired mean",
+        _pp(m),
+        _pp(lo),
+        _pp(hi),
+        unit="pp",
+        reproducible="statistical",
+        digits=2,
+        null=null,
+    )
 
 
 def _boot_mean(x: np.ndarray, seed: int, n_boot: int, **key: Any) -> tuple[float, float]:
@@ -793,7 +801,7 @@ def _boot_mean(x: np.ndarray, seed: int, n_boot: int, **key: Any) -> tuple[float
     x = np.asarray(x, dtype=float)
     if x.size < 2:
         return float("nan"), float("nan")
-    return _bootstrap_ci(x, job_rng(seed, "decisions_bootstrap", **key), n_boot)
+    return bootstrap_ci(x, job_rng(seed, "decisions_bootstrap", **key), n_boot, 0.95)
 
 
 def summarize_uav_regret(df: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFrame:
@@ -1024,15 +1032,7 @@ def uav_claims(
                 f"(relative regrets within ±{_param(_pp(margin))} pp)",
                 "Not in the paper; explains why the closed-loop comparisons (Fig. 5, UAV "
                 "claims) cannot separate the methods",
-                KeyNumber(
-                    f"NBO − {method_label(best_rs)} relative regret, paired mean",
-                    _pp(m),
-                    _pp(lo),
-                    _pp(hi),
-                    unit="pp",
-                    reproducible="statistical",
-                    digits=2,
-                ),
+                _regret_key(best_rs, m, lo, hi, null=None),
                 verdict,
                 UAV_RULES["DEC-6"],
                 measured=f"{n} belief states; NBO's mean relative regret "
@@ -1057,16 +1057,7 @@ def uav_claims(
                     "NBO (lower open-loop relative regret)",
                     "Sec. II: NBO may generate severely sub-optimal controls; tested on a "
                     "model variant (not the paper's model)",
-                    KeyNumber(
-                        f"NBO − {method_label(best_rs)} relative regret, paired mean",
-                        _pp(m),
-                        _pp(lo),
-                        _pp(hi),
-                        unit="pp",
-                        reproducible="statistical",
-                        digits=2,
-                        null=0.0,
-                    ),
+                    _regret_key(best_rs, m, lo, hi, null=0.0),
                     _ci_verdict(lo, hi),
                     UAV_RULES["DEC-7"],
                     measured=f"{n} belief states; mean relative regret NBO "
