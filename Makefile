@@ -48,7 +48,7 @@ publish: $(STAMP)
 	mkdir -p paper/figures
 	cp results/paper/replication.md results/paper/appendix.md results/paper/claims.json paper/
 	cp results/paper/figures/*.png paper/figures/
-	$(BIN)/python -m rsmhp.report splice README.md results/paper/glance.md
+	$(BIN)/python -m rsmhp.readme splice README.md results/paper/glance.md
 
 # compare a run with the committed reference paper/claims.json, claim by claim (runs what is
 # missing first); fails if a verdict flips or a key number leaves its tolerance

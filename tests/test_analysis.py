@@ -16,8 +16,8 @@ from rsmhp.analysis import lqg as analysis
 from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, run_convergence, run_nbo_error
 from rsmhp.figures import lqg as figs
 from rsmhp.io import IntermediateFileError, read_table, write_csv
+from rsmhp.ledger import Section
 from rsmhp.palette import method_colour
-from rsmhp.report import Section
 from rsmhp.stats import binomial_ci, loglog_slope, mean_ci, rmse_ci
 
 from .conftest import PAPER, PAPER_U

@@ -457,7 +457,7 @@ def test_every_table_and_figure_is_declared_and_captioned(section):
 
 
 def test_section_round_trips_through_json(section, tmp_path):
-    from rsmhp.report import Section
+    from rsmhp.ledger import Section
 
     sec, _ = section
     sec.save(tmp_path / "estimators.json")

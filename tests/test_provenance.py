@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import subprocess
 
-from rsmhp.report import provenance
+from rsmhp.provenance import provenance
 
 
 def test_provenance_names_commit_config_versions_blas_and_cpu(tmp_path):

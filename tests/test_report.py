@@ -14,21 +14,10 @@ import pandas as pd
 import pytest
 
 from rsmhp import verify as vfy
-from rsmhp.report import (
-    MARK_BEGIN,
-    MARK_END,
-    Claim,
-    KeyNumber,
-    Section,
-    claims_records,
-    fmt,
-    fmt_ci,
-    glance_table,
-    markdown_table,
-    render_appendix,
-    render_report,
-    splice,
-)
+from rsmhp.ledger import Claim, KeyNumber, Section, claims_records
+from rsmhp.markdown import fmt, fmt_ci, markdown_table
+from rsmhp.readme import MARK_BEGIN, MARK_END, splice
+from rsmhp.report import glance_table, render_appendix, render_report
 
 ROOT = Path(__file__).resolve().parents[1]
 

@@ -14,8 +14,10 @@ from rerun.chunk import RrdReader
 
 from rsmhp.analysis import uav as analysis
 from rsmhp.experiments.uav import NONDETERMINISTIC_COLUMNS, RUN_COLUMNS, run_chunk
+from rsmhp.ledger import Section
+from rsmhp.markdown import fmt
 from rsmhp.palette import method_colour, method_label, method_rgb
-from rsmhp.report import Section, fmt, render_appendix, render_report
+from rsmhp.report import render_appendix, render_report
 from rsmhp.uav import simulation
 from rsmhp.uav.recording import record_uav_run
 from rsmhp.uav.simulation import UAVSetup, draw_scenario, method_specs, simulate_run

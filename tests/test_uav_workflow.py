@@ -10,7 +10,8 @@ from rerun.chunk import RrdReader
 
 from rsmhp.analysis.uav import FIGURES
 from rsmhp.experiments.uav import NONDETERMINISTIC_COLUMNS
-from rsmhp.report import Section, fmt
+from rsmhp.ledger import Section
+from rsmhp.markdown import fmt
 from tests.test_workflow import TINY, snakemake
 
 pytestmark = pytest.mark.workflow

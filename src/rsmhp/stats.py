@@ -4,6 +4,7 @@
 * :func:`binomial_ci` - Clopper-Pearson (exact) interval of a proportion.
 * :func:`loglog_slope` - OLS slope of log(y) on log(x) with a t-based confidence interval.
 * :func:`rmse_ci` - RMSE with a chi-square interval assuming the errors are N(0, s^2)-like.
+* :func:`bootstrap_ci` - percentile bootstrap interval of any statistic.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from scipy import stats
 
 from rsmhp import guards
 
-__all__ = ["SlopeFit", "binomial_ci", "loglog_slope", "mean_ci", "rmse_ci"]
+__all__ = ["SlopeFit", "binomial_ci", "bootstrap_ci", "loglog_slope", "mean_ci", "rmse_ci"]
 
 
 def _level(level: float) -> None:
@@ -81,3 +82,16 @@ def loglog_slope(x: np.ndarray, y: np.ndarray, level: float = 0.95) -> SlopeFit:
     return SlopeFit(
         float(res.slope), float(res.slope - half), float(res.slope + half), float(res.intercept)
     )
+
+
+def bootstrap_ci(
+    x: np.ndarray, rng: np.random.Generator, n_boot: int, level: float, stat=np.mean
+) -> tuple[float, float]:
+    """Percentile bootstrap CI of ``stat`` over resamples of ``x`` (with replacement): the
+    ``(1 - level)/2`` and ``(1 + level)/2`` quantiles of ``stat`` over ``n_boot`` resamples
+    (``n_boot x len(x)`` indices drawn from ``rng`` in one call)."""
+    x = np.asarray(x, dtype=float)
+    idx = rng.integers(0, x.size, size=(n_boot, x.size))
+    boots = stat(x[idx], axis=1)
+    lo, hi = np.quantile(boots, [0.5 - level / 2, 0.5 + level / 2])
+    return float(lo), float(hi)

@@ -35,7 +35,8 @@ from typing import Any
 import pandas as pd
 from scipy.stats import norm
 
-from rsmhp.report import Claim, fmt, markdown_table
+from rsmhp.ledger import Claim
+from rsmhp.markdown import fmt, markdown_table
 
 __all__ = ["VerificationError", "compare", "load_claims", "main", "render", "tolerance"]
 

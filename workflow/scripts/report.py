@@ -7,15 +7,10 @@ import shutil
 from pathlib import Path
 
 from rsmhp.io import write_text
+from rsmhp.ledger import Section, claims_records
 from rsmhp.pipeline import rule_logging
-from rsmhp.report import (
-    Section,
-    claims_records,
-    glance_table,
-    provenance,
-    render_appendix,
-    render_report,
-)
+from rsmhp.provenance import provenance
+from rsmhp.report import glance_table, render_appendix, render_report
 
 with rule_logging(snakemake.log[0], snakemake.rule) as log:
     sections = [Section.load(p) for p in snakemake.input.sections]

@@ -55,11 +55,11 @@ import pandas as pd
 from scipy import stats as sps
 
 from rsmhp import lqg
-from rsmhp.analysis.uav import bootstrap_ci
+from rsmhp.ledger import Claim, KeyNumber, Section
+from rsmhp.markdown import fmt, fmt_ci, markdown_table
 from rsmhp.palette import method_label
-from rsmhp.report import Claim, KeyNumber, Section, fmt, fmt_ci, markdown_table
 from rsmhp.seeding import job_rng
-from rsmhp.stats import loglog_slope, mean_ci
+from rsmhp.stats import bootstrap_ci, loglog_slope, mean_ci
 
 __all__ = [
     "EQUIVALENCE_MARGIN",

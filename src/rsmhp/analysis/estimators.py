@@ -66,8 +66,9 @@ import numpy as np
 import pandas as pd
 
 from rsmhp.experiments.estimators import ABLATION_COLUMNS, build_problem
+from rsmhp.ledger import Claim, KeyNumber, Section
 from rsmhp.linear_quadratic import LinearQuadratic
-from rsmhp.report import Claim, KeyNumber, Section, fmt, fmt_ci, markdown_table
+from rsmhp.markdown import fmt, fmt_ci, markdown_table
 from rsmhp.seeding import job_rng
 from rsmhp.stats import SlopeFit, binomial_ci, loglog_slope
 

@@ -53,7 +53,8 @@ from scipy import stats as sps
 
 from rsmhp import lqg
 from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, NBO_ERROR_COLUMNS
-from rsmhp.report import Claim, KeyNumber, Section, fmt, fmt_ci, markdown_table
+from rsmhp.ledger import Claim, KeyNumber, Section
+from rsmhp.markdown import fmt, fmt_ci, markdown_table
 from rsmhp.stats import binomial_ci, loglog_slope, mean_ci, rmse_ci
 
 __all__ = [

@@ -49,13 +49,14 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
+from rsmhp.ledger import Claim, KeyNumber, Section
+from rsmhp.markdown import fmt, fmt_ci, markdown_table
 from rsmhp.palette import method_label
-from rsmhp.report import Claim, KeyNumber, Section, fmt, fmt_ci, markdown_table
 from rsmhp.seeding import job_rng
+from rsmhp.stats import bootstrap_ci
 
 __all__ = [
     "FIGURES",
-    "bootstrap_ci",
     "cdf_methods",
     "cdf_range",
     "clip_note",
@@ -77,18 +78,6 @@ __all__ = [
 #: figure stems written by the figure rule and referenced by the report section, in the order
 #: of the section: each paper-style CDF is followed by its paired view
 FIGURES = ("uav_error_cdf_nt", "uav_paired_diff_nt", "uav_error_cdf_nbo", "uav_paired_diff")
-
-
-def bootstrap_ci(
-    x: np.ndarray, rng: np.random.Generator, n_boot: int, level: float, stat=np.mean
-) -> tuple[float, float]:
-    """Percentile bootstrap CI of ``stat`` over resamples of ``x`` (with replacement): the
-    ``(1 - level)/2`` and ``(1 + level)/2`` quantiles of ``stat`` over ``n_boot`` resamples."""
-    x = np.asarray(x, dtype=float)
-    idx = rng.integers(0, x.size, size=(n_boot, x.size))
-    boots = stat(x[idx], axis=1)
-    lo, hi = np.quantile(boots, [0.5 - level / 2, 0.5 + level / 2])
-    return float(lo), float(hi)
 
 
 def verdict(ci_low: float, ci_high: float) -> str:

@@ -22,8 +22,8 @@ from rsmhp.analysis.decisions import (
     axis_value,
 )
 from rsmhp.figures import theme
+from rsmhp.markdown import fmt
 from rsmhp.palette import LINESTYLES, method_colour, method_label
-from rsmhp.report import fmt
 from rsmhp.seeding import job_rng
 
 __all__ = ["lqg_regret_figure", "uav_map_figure", "uav_regret_figure"]

@@ -18,8 +18,8 @@ import seaborn as sns
 
 from rsmhp.analysis.lqg import NBO_Z_CLIP, chebyshev_long, eps_label, fmt_exact, nbo_z_limit
 from rsmhp.figures import theme
+from rsmhp.markdown import fmt
 from rsmhp.palette import LINESTYLES, method_colour, method_label
-from rsmhp.report import fmt
 
 __all__ = [
     "convergence_figure",

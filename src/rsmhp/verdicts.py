@@ -1,0 +1,119 @@
+r"""Verdict rules as small objects: one definition gives both the rule's text (printed next to
+the claim in the report) and its evaluation, so the two cannot drift apart.
+
+A :class:`Rule` is an ordered list of :class:`Case` s, each a verdict with a condition on
+named *facts* (numbers computed by the study's statistics, e.g. ``{"max_z": 2.1}``), and the
+verdict that holds when no case does::
+
+    rule = Rule(
+        basis="z = (simulated - closed form) / SE per cell",
+        cases=(Case("supported", "max |z| ≤ 3.2", lambda f: f["max_z"] <= 3.2),),
+        otherwise="not supported",
+    )
+    rule.verdict({"max_z": 2.1})  # "supported"
+    rule.text()  # "z = ... per cell: supported if max |z| ≤ 3.2, not supported otherwise"
+
+The cases are tried in order; the first whose condition holds gives the verdict. The common
+shapes have constructors (:func:`at_most`, :func:`ci_side`), whose boundary behaviour is
+tested in ``tests/test_verdicts.py``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass
+
+from rsmhp.ledger import VERDICTS
+
+__all__ = ["Case", "Rule", "at_most", "ci_side"]
+
+Facts = Mapping[str, float]
+
+
+@dataclass(frozen=True)
+class Case:
+    """``verdict`` when ``test(facts)`` is true; ``when`` is the condition in words."""
+
+    verdict: str
+    when: str
+    test: Callable[[Facts], bool]
+
+    def __post_init__(self) -> None:
+        if self.verdict not in VERDICTS:
+            raise ValueError(f"Case.verdict must be one of {VERDICTS}, got {self.verdict!r}")
+        if not self.when.strip():
+            raise ValueError("Case.when must say the condition in words, got ''")
+
+
+@dataclass(frozen=True)
+class Rule:
+    """A verdict rule: ``basis`` (how the key number is obtained, may be empty), the ordered
+    ``cases`` and the verdict ``otherwise``."""
+
+    cases: tuple[Case, ...]
+    otherwise: str
+    basis: str = ""
+
+    def __post_init__(self) -> None:
+        if not self.cases:
+            raise ValueError("Rule.cases must hold at least one Case")
+        if self.otherwise not in VERDICTS:
+            raise ValueError(f"Rule.otherwise must be one of {VERDICTS}, got {self.otherwise!r}")
+
+    def verdict(self, facts: Facts) -> str:
+        """The verdict of the first case whose condition holds, else ``otherwise``."""
+        for case in self.cases:
+            if case.test(facts):
+                return case.verdict
+        return self.otherwise
+
+    def text(self) -> str:
+        """``basis: v1 if c1; v2 if c2; v3 otherwise`` (the rule as the report prints it)."""
+        parts = [f"{c.verdict} if {c.when}" for c in self.cases]
+        body = "; ".join(parts) + f"; {self.otherwise} otherwise"
+        return f"{self.basis}: {body}" if self.basis else body[0].upper() + body[1:]
+
+
+def at_most(name: str, limit: float, *, limit_text: str, basis: str = "") -> Rule:
+    """``supported`` if ``facts[name] <= limit`` (``limit_text`` prints the limit and why),
+    ``not supported`` otherwise. The boundary ``facts[name] == limit`` is supported."""
+    return Rule(
+        basis=basis,
+        cases=(Case("supported", f"{name} ≤ {limit_text}", lambda f: f[name] <= limit),),
+        otherwise="not supported",
+    )
+
+
+def ci_side(
+    name: str,
+    null: float,
+    *,
+    claimed: str,
+    null_text: str | None = None,
+    basis: str = "",
+) -> Rule:
+    r"""The CI rule of paired differences: with facts ``<name>_low`` and ``<name>_high`` (the
+    95% CI limits of ``name``), ``supported`` if the CI lies entirely on the ``claimed``
+    side of ``null`` (``"below"`` or ``"above"``, strictly), ``not supported`` if it lies
+    entirely on the other side, ``inconclusive`` if it contains ``null``."""
+    if claimed not in ("below", "above"):
+        raise ValueError(f"claimed must be 'below' or 'above', got {claimed!r}")
+    lo, hi = f"{name}_low", f"{name}_high"
+    txt = null_text if null_text is not None else f"{null:g}"
+
+    def is_below(f: Facts) -> bool:
+        return f[hi] < null
+
+    def is_above(f: Facts) -> bool:
+        return f[lo] > null
+
+    first, second = (is_below, is_above) if claimed == "below" else (is_above, is_below)
+    other = "above" if claimed == "below" else "below"
+    return Rule(
+        basis=basis,
+        cases=(
+            Case("supported", f"the 95% CI of {name} lies entirely {claimed} {txt}", first),
+            Case("not supported", f"it lies entirely {other} {txt}", second),
+        ),
+        otherwise="inconclusive",
+    )

@@ -1,0 +1,65 @@
+"""Verdict rules (rsmhp.verdicts): text and evaluation from one definition, boundaries."""
+
+import pytest
+
+from rsmhp.verdicts import Case, Rule, at_most, ci_side
+
+
+def test_at_most_boundary_is_supported_and_text_names_the_limit():
+    rule = at_most("max |z|", 2.5, limit_text="2.5 (Bonferroni)", basis="z per cell")
+    assert rule.verdict({"max |z|": 2.5}) == "supported"
+    assert rule.verdict({"max |z|": 2.5000001}) == "not supported"
+    assert rule.verdict({"max |z|": -1.0}) == "supported"
+    assert rule.text() == (
+        "z per cell: supported if max |z| ≤ 2.5 (Bonferroni); not supported otherwise"
+    )
+
+
+@pytest.mark.parametrize(
+    ("low", "high", "claimed", "verdict"),
+    [
+        (-2.0, -0.1, "below", "supported"),
+        (-2.0, 0.0, "below", "inconclusive"),  # CI touching the null does not exclude it
+        (0.0, 1.0, "below", "inconclusive"),
+        (0.1, 1.0, "below", "not supported"),
+        (0.1, 1.0, "above", "supported"),
+        (-1.0, -0.1, "above", "not supported"),
+        (-1.0, 1.0, "above", "inconclusive"),
+    ],
+)
+def test_ci_side_on_and_off_the_null(low, high, claimed, verdict):
+    rule = ci_side("d", 0.0, claimed=claimed)
+    assert rule.verdict({"d_low": low, "d_high": high}) == verdict
+
+
+def test_ci_side_text_lists_every_case_in_order():
+    text = ci_side("d", 0.0, claimed="below", null_text="0 m", basis="paired d").text()
+    assert text == (
+        "paired d: supported if the 95% CI of d lies entirely below 0 m; not supported if it "
+        "lies entirely above 0 m; inconclusive otherwise"
+    )
+
+
+def test_first_matching_case_wins_and_otherwise_applies():
+    rule = Rule(
+        cases=(
+            Case("supported", "x > 1", lambda f: f["x"] > 1),
+            Case("not supported", "x > 0", lambda f: f["x"] > 0),
+        ),
+        otherwise="inconclusive",
+    )
+    assert [rule.verdict({"x": v}) for v in (2, 1, 0)] == [
+        "supported",
+        "not supported",
+        "inconclusive",
+    ]
+    assert rule.text().startswith("Supported if x > 1; not supported if x > 0")
+
+
+def test_bad_definitions_are_refused():
+    with pytest.raises(ValueError, match="verdict must be one of"):
+        Case("maybe", "x", lambda f: True)
+    with pytest.raises(ValueError, match="at least one Case"):
+        Rule(cases=(), otherwise="inconclusive")
+    with pytest.raises(ValueError, match="claimed must be"):
+        ci_side("d", 0.0, claimed="sideways")
