@@ -31,13 +31,19 @@ import yaml
 from snakemake.utils import validate
 from threadpoolctl import threadpool_limits
 import rsmhp
-from rsmhp.uav.simulation import UAVSetup, method_specs, simulate_run
+from rsmhp.uav.simulation import UAVSetup, simulate_run
+try:  # the method registry (this version); older checkouts (--baseline) had method_specs
+    from rsmhp.uav import methods as _methods
+    spec_of = lambda uav, name: _methods.from_config(uav["methods"])[name]
+except ImportError:
+    from rsmhp.uav.simulation import method_specs
+    spec_of = lambda uav, name: method_specs(uav)[name]
 
 root, method, runs = sys.argv[1], sys.argv[2], [int(r) for r in sys.argv[3].split(",")]
 cfg = yaml.safe_load(open(f"{root}/config/config.yaml"))
 validate(cfg, f"{root}/workflow/schemas/config.schema.yaml")
 setup = UAVSetup.from_config(cfg["uav"])
-spec = method_specs(cfg["uav"])[method]
+spec = spec_of(cfg["uav"], method)
 out = []
 with threadpool_limits(limits=1):
     simulate_run(setup, spec, cfg["seed"], runs[0])  # warm-up, not timed
@@ -75,10 +81,10 @@ def main() -> None:
     sys.path.insert(0, str(ROOT / "src"))
     import yaml
 
-    from rsmhp.uav.simulation import method_specs
+    from rsmhp.uav import methods as registry
 
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
-    methods = args.methods or list(method_specs(cfg["uav"]))
+    methods = args.methods or list(registry.from_config(cfg["uav"]["methods"]))
     runs = list(range(1, args.runs + 1))
     print(f"closed-loop runs {runs} of the default config, one thread, {os.cpu_count()} CPUs")
     header = f"{'method':14s} {'this (s/run)':>13s}"

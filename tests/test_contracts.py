@@ -21,7 +21,7 @@ from rsmhp.config import CONFIG_PATH, SCHEMA_PATH, merge
 from rsmhp.contracts import Contract, check_table, read_checked
 from rsmhp.experiments import decisions_lqg, decisions_uav, estimators, lqg, uav
 from rsmhp.io import IntermediateFileError
-from rsmhp.uav.simulation import method_specs
+from rsmhp.uav import methods as uav_methods
 from tests.test_workflow import TINY, snakemake
 
 # ----------------------------------------------------------------------------- mechanism
@@ -144,7 +144,7 @@ def effective() -> dict:
 
 def _intermediates(cfg: dict) -> dict[str, tuple[str, Contract]]:
     u, dec = cfg["uav"], cfg["decisions"]
-    specs = method_specs(u)
+    specs = uav_methods.from_config(u["methods"])
     n_chunks = min(u["chunks"], u["runs"])
     method = next(iter(specs))
     chunk_runs, chunk_steps = uav.chunk_contracts(

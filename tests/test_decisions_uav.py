@@ -27,7 +27,8 @@ from rsmhp.experiments.decisions_uav import (
 )
 from rsmhp.figures import decisions as figs
 from rsmhp.palette import method_colour
-from rsmhp.uav.simulation import UAVSetup, draw_scenario, method_specs, simulate_run
+from rsmhp.uav import methods as uav_methods
+from rsmhp.uav.simulation import UAVSetup, draw_scenario, simulate_run
 
 ROOT = Path(__file__).resolve().parents[1]
 UAV = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["uav"]
@@ -51,7 +52,7 @@ def test_belief_states_are_the_closed_loop_beliefs():
     np.testing.assert_array_equal(states[3].x_hat, sc.estimate)
     np.testing.assert_array_equal(states[3].P_hat, setup.P0)
     assert not states[3].warm.any()
-    nbo = method_specs({"methods": {"nbo": True, "rsmhp_nt": [], "tree": []}})["nbo"]
+    nbo = uav_methods.from_config({"nbo": True, "rsmhp_nt": [], "tree": []})["nbo"]
     _, rows = simulate_run(setup, nbo, 5, 1)
     assert np.trace(states[4].P_hat) == pytest.approx(rows[2]["trace"], rel=1e-14)  # step 3
     assert (states[5].uav[0], states[5].uav[1]) == (rows[5]["uav_x"], rows[5]["uav_y"])
@@ -62,7 +63,7 @@ def test_belief_states_are_the_closed_loop_beliefs():
 def test_score_state_rows():
     setup = UAVSetup.from_config(_short())
     state = belief_states(setup, "paper", 5, [0], [3])[0]
-    methods = method_specs({"methods": METHODS})
+    methods = uav_methods.from_config(METHODS)
     rows = score_state(state, setup, methods, SCORING, 5)
     assert [r["method"] for r in rows] == list(methods)
     for r in rows:
@@ -87,7 +88,7 @@ def test_a_certain_belief_makes_every_method_plan_alike():
     setup = UAVSetup.from_config(cfg)
     state = belief_states(setup, "paper", 5, [0], [3])[0]
     state = dataclasses.replace(state, P_hat=1e-10 * np.eye(4))
-    rows = score_state(state, setup, method_specs({"methods": METHODS}), SCORING, 5)
+    rows = score_state(state, setup, uav_methods.from_config(METHODS), SCORING, 5)
     costs = [r["eval_cost"] for r in rows]
     assert max(costs) - min(costs) <= 1e-6 * max(costs)
 

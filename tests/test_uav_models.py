@@ -109,9 +109,9 @@ def test_nominal_is_noise_free_propagation():
 def test_sample_tree_without_and_with_pruning(rng):
     model = TargetModel(1.0, 1.0)
     x, P = np.zeros(4), np.diag([4.0, 4.0, 1.0, 1.0])
-    full, _ = target.sample_tree(x, P, 2, 3, 10_000, model, rng)
+    full, _ = target.pruned_tree(x, P, 2, 3, 10_000, model, rng)
     assert full.shape == (27, 2, 4)  # N^(H+1) leaves, nothing pruned
-    pruned, ll = target.sample_tree(x, P, 4, 3, 7, model, np.random.default_rng(1))
+    pruned, ll = target.pruned_tree(x, P, 4, 3, 7, model, np.random.default_rng(1))
     assert pruned.shape == (7, 4, 4)
     assert np.all(np.diff(ll) <= 0)  # sorted by decreasing likeliness
     # every kept path is consistent with the dynamics: x_j - F x_{j-1} is one of the level draws
@@ -131,8 +131,8 @@ def test_compiled_tree_equals_generic_sampler(seed):
     x = r.normal(size=4) * 100
     model = TargetModel(float(r.uniform(0.2, 2.0)), float(10.0 ** r.uniform(-2, 1)))
     H, N, M = int(r.integers(1, 7)), int(r.integers(1, 9)), int(r.integers(1, 150))
-    got, ll = target.sample_tree(x, P, H, N, M, model, np.random.default_rng(seed))
-    ref, ll_ref = target.sample_tree_reference(x, P, H, N, M, model, np.random.default_rng(seed))
+    got, ll = target.pruned_tree(x, P, H, N, M, model, np.random.default_rng(seed))
+    ref, ll_ref = target.pruned_tree_reference(x, P, H, N, M, model, np.random.default_rng(seed))
     assert got.shape == ref.shape == (min(M, N ** (H + 1)), H, 4)
     np.testing.assert_allclose(ll, ll_ref, rtol=1e-12, atol=1e-12)
     scale = max(1.0, np.abs(ref).max())
@@ -152,9 +152,9 @@ def test_sample_tree_refuses_bad_arguments(rng):
     for bad, name in (({"horizon": 0}, "horizon"), ({"n_branch": 0}, "N"), ({"max_keep": 0}, "M")):
         args = {"horizon": 3, "n_branch": 2, "max_keep": 4} | bad
         with pytest.raises(ValueError, match=f"{name}.*must be >= 1, got 0"):
-            target.sample_tree(np.zeros(4), P, model=model, rng=rng, **args)
+            target.pruned_tree(np.zeros(4), P, model=model, rng=rng, **args)
     with pytest.raises(ValueError, match="P_hat must have shape"):
-        target.sample_tree(np.zeros(4), np.eye(3), 3, 2, 4, model, rng)
+        target.pruned_tree(np.zeros(4), np.eye(3), 3, 2, 4, model, rng)
 
 
 def test_sample_independent_moments():

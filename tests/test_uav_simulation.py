@@ -18,9 +18,10 @@ from rsmhp.ledger import Section
 from rsmhp.markdown import fmt
 from rsmhp.palette import method_colour, method_label, method_rgb
 from rsmhp.report import render_appendix, render_report
+from rsmhp.uav import methods as uav_methods
 from rsmhp.uav import simulation
 from rsmhp.uav.recording import record_uav_run
-from rsmhp.uav.simulation import UAVSetup, draw_scenario, method_specs, simulate_run
+from rsmhp.uav.simulation import UAVSetup, draw_scenario, simulate_run
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_UAV = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["uav"]
@@ -41,11 +42,11 @@ def _det(summary: dict) -> dict:
 
 def test_same_seed_same_run(short_cfg):
     setup = UAVSetup.from_config(short_cfg)
-    for m in method_specs(short_cfg).values():
+    for m in uav_methods.from_config(short_cfg["methods"]).values():
         a, sa = simulate_run(setup, m, 11, 2)
         b, sb = simulate_run(setup, m, 11, 2)
         assert _det(a) == _det(b) and sa == sb
-    c, _ = simulate_run(setup, method_specs(short_cfg)["nbo"], 12, 2)
+    c, _ = simulate_run(setup, uav_methods.from_config(short_cfg["methods"])["nbo"], 12, 2)
     assert c["mean_error"] != a["mean_error"]
 
 
@@ -61,7 +62,7 @@ def test_methods_share_scenario_truth_and_measurement_noise(short_cfg, monkeypat
 
     monkeypatch.setattr(simulation.sensor, "measurement_noise", spy)
     steps = {}
-    for name, m in method_specs(short_cfg).items():
+    for name, m in uav_methods.from_config(short_cfg["methods"]).items():
         current["m"] = name
         _, steps[name] = simulate_run(setup, m, 5, 0)
     names = list(steps)
@@ -88,7 +89,7 @@ def test_scenario_ranges(short_cfg):
 
 
 def test_chunking_and_workers_do_not_change_numbers(short_cfg):
-    spec = method_specs(short_cfg)["rsmhp_nt10"]
+    spec = uav_methods.from_config(short_cfg["methods"])["rsmhp_nt10"]
     whole, whole_steps = run_chunk(short_cfg, spec, [0, 1, 2], seed=4, n_jobs=1)
     parts = [run_chunk(short_cfg, spec, r, seed=4, n_jobs=2) for r in ([0], [1, 2])]
     split = pd.concat([p[0] for p in parts], ignore_index=True)
@@ -103,7 +104,7 @@ def test_chunking_and_workers_do_not_change_numbers(short_cfg):
 
 def test_recording_contents_and_consistency(short_cfg, tmp_path):
     setup = UAVSetup.from_config(short_cfg)
-    specs = list(method_specs(short_cfg).values())
+    specs = list(uav_methods.from_config(short_cfg["methods"]).values())
     path = tmp_path / "run.rrd"
     rows, summaries = record_uav_run(path, setup, specs, seed=5, run=1, max_hypotheses=4)
     reader = RrdReader(path)
@@ -311,7 +312,7 @@ def test_recording_colours_are_the_palette(short_cfg, tmp_path):
     for c in (TRUE_C, EST_C):
         assert min(np.linalg.norm(np.subtract(c, p)) for p in rgb) > 100
     setup = UAVSetup.from_config(short_cfg)
-    specs = list(method_specs(short_cfg).values())
+    specs = list(uav_methods.from_config(short_cfg["methods"]).values())
     path = tmp_path / "run.rrd"
     record_uav_run(path, setup, specs, seed=5, run=1, max_hypotheses=2)
 

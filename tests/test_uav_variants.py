@@ -16,10 +16,11 @@ import yaml
 from filterpy.kalman import KalmanFilter
 
 from rsmhp.uav import fused, kinematics
+from rsmhp.uav import methods as uav_methods
 from rsmhp.uav.kernel import covariance_traces, objective
 from rsmhp.uav.kinematics import UAVParams
 from rsmhp.uav.sensor import SensorModel, detected, detection_probability
-from rsmhp.uav.simulation import UAVSetup, method_specs, simulate_run
+from rsmhp.uav.simulation import UAVSetup, simulate_run
 from rsmhp.uav.target import TargetModel
 from rsmhp.uav.tracker import MEASUREMENT_MATRIX
 
@@ -189,7 +190,7 @@ def test_a_footprint_that_never_binds_reproduces_the_paper_model_bit_for_bit():
     base = UAVSetup.from_config(_short_cfg())
     wide = UAVSetup.from_config(_short_cfg(footprint_radius=1e9))
     assert not base.sensor.limited and wide.sensor.limited
-    for name, spec in method_specs(_short_cfg()).items():
+    for name, spec in uav_methods.from_config(_short_cfg()["methods"]).items():
         s0, r0 = simulate_run(base, spec, 3, 1)
         s1, r1 = simulate_run(wide, spec, 3, 1)
         assert s1.pop("detect_rate") == 1.0
@@ -204,7 +205,7 @@ def test_missed_detections_in_the_truth_simulation():
     tracker's covariance is filterpy's predict-only recursion from P0."""
     cfg = _short_cfg(footprint_radius=1.0, footprint_width=0.5)
     setup = UAVSetup.from_config(cfg)
-    spec = method_specs(cfg)["nbo"]
+    spec = uav_methods.from_config(cfg["methods"])["nbo"]
     summary, rows = simulate_run(setup, spec, 3, 2)
     assert summary["detect_rate"] == 0.0 and not any(r["detected"] for r in rows)
     kf = KalmanFilter(dim_x=4, dim_z=2)
@@ -232,7 +233,7 @@ def test_recording_draws_the_footprint(tmp_path):
 
     cfg = _short_cfg(footprint_radius=150.0)
     setup = UAVSetup.from_config(cfg)
-    specs = list(method_specs(cfg).values())
+    specs = list(uav_methods.from_config(cfg["methods"]).values())
     rows, summaries = record_uav_run(tmp_path / "fp.rrd", setup, specs, 3, 0, max_hypotheses=3)
     for spec in specs:
         assert rows[f"{spec.name}/map/footprint"] == setup.steps

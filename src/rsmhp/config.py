@@ -22,6 +22,8 @@ import yaml
 from jsonschema import Draft202012Validator, validators
 from jsonschema.exceptions import ValidationError
 
+from rsmhp.uav import methods as uav_methods
+
 __all__ = [
     "CONFIG_PATH",
     "SCHEMA_PATH",
@@ -43,8 +45,23 @@ class ConfigError(ValueError):
 
 
 def load_schema(path: str | os.PathLike | None = None) -> dict[str, Any]:
+    """The config schema with every registered UAV method family's fragment inserted into
+    ``$defs/uav_methods`` (:func:`rsmhp.uav.methods.schema`): the file itself names no
+    family, so a new method needs no schema edit."""
     with open(path or SCHEMA_PATH, encoding="utf-8") as fh:
-        return yaml.safe_load(fh)
+        schema = yaml.safe_load(fh)
+    return with_methods(schema)
+
+
+def with_methods(schema: Mapping[str, Any]) -> dict[str, Any]:
+    """``schema`` (a copy) with ``$defs/uav_methods`` from the method registry."""
+    from rsmhp.uav import methods
+
+    out = copy.deepcopy(dict(schema))
+    defs = out.get("$defs", {})
+    if "uav_methods" in defs:
+        defs["uav_methods"] = {**defs["uav_methods"], **methods.schema()}
+    return out
 
 
 def load_config_file(path: str | os.PathLike) -> dict[str, Any]:
@@ -231,8 +248,7 @@ def _nothing_to_run(config: Mapping[str, Any]) -> list[str]:
             )
     methods = (config.get("uav", {}) or {}).get("methods")
     if isinstance(methods, Mapping):
-        n = bool(methods.get("nbo", True)) + len(methods.get("rsmhp_nt") or [])
-        n += len(methods.get("tree") or [])
+        n = uav_methods.count(methods)
         if n < 2:
             problems.append(
                 f"uav.methods: {n} method(s) (allowed: at least 2, e.g. nbo and one rsmhp_nt, "
@@ -261,15 +277,17 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         problems.append(f"decisions.uav.models: duplicate name(s) {dup} (allowed: unique names)")
+    base = uav_methods.baseline()
     for section in ("uav", "map"):
         methods = (dec.get(section, {}) or {}).get("methods")
         if isinstance(methods, Mapping) and methods:
-            n = bool(methods.get("nbo", True)) + len(methods.get("rsmhp_nt", []) or [])
-            n += len(methods.get("tree", []) or [])
-            if methods.get("nbo") is False:
+            n = uav_methods.count(methods)
+            if not methods.get(base.config_key, base.default):
                 problems.append(
-                    f"decisions.{section}.methods.nbo: false (allowed: true; NBO is the "
-                    "baseline every comparison of the decision study is made against)"
+                    f"decisions.{section}.methods.{base.config_key}: "
+                    f"{str(methods.get(base.config_key)).lower()} (allowed: true; "
+                    f"{base.family_label} is "
+                    "the baseline every comparison of the decision study is made against)"
                 )
             if n < 2 and section == "map":
                 problems.append(
@@ -278,6 +296,9 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
                 )
             if n < 1:
                 problems.append(f"decisions.{section}.methods: no method (allowed: at least 1)")
+            problems += uav_methods.config_problems(
+                methods, f"decisions.{section}.methods", config.get("uav", {}) or {}
+            )
     rec = (dec.get("recording", {}) or {}).get("model")
     if rec is not None and names and rec not in names:
         problems.append(
@@ -330,15 +351,7 @@ def _uav_cross_field(uav: Mapping[str, Any]) -> list[str]:
                 f"uav.scenario.uav_speed: {sc['uav_speed']} is outside the aircraft's speed range "
                 f"(allowed: {ac['speed_min']} <= uav_speed <= {ac['speed_max']})"
             )
-    horizon = (uav.get("planner", {}) or {}).get("horizon")
-    for i, tree in enumerate((uav.get("methods", {}) or {}).get("tree", []) or []):
-        if horizon is not None and {"N", "M"} <= tree.keys():
-            leaves = tree["N"] ** (horizon + 1)
-            if tree["M"] > leaves:
-                problems.append(
-                    f"uav.methods.tree[{i}].M: {tree['M']} is greater than the tree's "
-                    f"N^(H+1) = {leaves} leaves (allowed: 1 <= M <= N^(H+1))"
-                )
+    problems += uav_methods.config_problems(uav.get("methods"), "uav.methods", uav)
     return problems
 
 
@@ -424,8 +437,7 @@ def check_config(
 
     ``schema`` is the schema mapping or its path (default: the repository's schema file).
     """
-    if not isinstance(schema, Mapping):
-        schema = load_schema(schema)
+    schema = load_schema(schema) if not isinstance(schema, Mapping) else with_methods(schema)
     validator = _Validator(schema)
     errors = sorted(
         validator.iter_errors(dict(config)), key=lambda e: list(map(str, e.absolute_path))

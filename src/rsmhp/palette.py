@@ -1,18 +1,18 @@
 """One colour per method, shared by every figure and every rerun recording.
 
-Methods are named as in the results tables: ``nbo``, ``mc`` (independent, non-overlapping
-trajectories), ``rsmhp_nt<N_T>`` (RS-MHP with N_T trajectories: shades of the ``mc`` blue,
-darker for larger N_T), ``tree`` (shared draws per level), ``tree_pernode`` (fresh draws per
-node), ``pruned`` / ``tree_n<N>_m<M>`` (pruned tree), ``antithetic``, ``sobol``,
-``cubature``, ``gauss_hermite``; ``exact`` is the exact cost or optimum. Colours come from
+Methods are named as in the results tables. The schemes of the LQG and estimator studies have
+fixed colours here: ``nbo``, ``mc`` (independent, non-overlapping trajectories), ``tree``
+(shared draws per level), ``tree_pernode`` (fresh draws per node), ``pruned`` (pruned tree),
+``antithetic``, ``sobol``, ``cubature``, ``gauss_hermite``; ``exact`` is the exact cost or
+optimum. A UAV planning method (``rsmhp_nt<N_T>``, ``tree_n<N>_m<M>``, any registered
+family) takes the colour its family module declares (:mod:`rsmhp.uav.methods`; RS-MHP N_T
+in shades of the ``mc`` blue, darker for larger N_T). Colours come from
 seaborn's colour-blind palette (as RGB hex strings, so this module needs no plotting library);
 derived or closed-form curves use the method's colour with a dashed line, likeliness-weighted
 variants a dotted one (:data:`LINESTYLES`).
 """
 
 from __future__ import annotations
-
-import re
 
 __all__ = [
     "LINESTYLES",
@@ -54,30 +54,28 @@ METHOD_COLOURS: dict[str, str] = {
 #: line style by role: a measured curve, a derived (closed-form) curve, a weighted variant
 LINESTYLES = {"measured": "-", "derived": "--", "weighted": ":"}
 
-#: RS-MHP shades (light to dark) for increasing N_T; blends of the ``mc`` blue with white/black
-_RSMHP_SHADES = ("#67a9d9", "#3a8cc6", "#0173b2", "#01548a", "#013a5e")
-
-_RSMHP = re.compile(r"^rsmhp_nt(\d+)$")
-_PRUNED = re.compile(r"^tree_n(\d+)_m(\d+)$")
-
 
 def method_colour(method: str) -> str:
-    """Hex colour of ``method``. RS-MHP variants get a fixed shade of the ``mc`` blue by N_T
-    (<= 10, <= 50, <= 100, <= 250, larger: light to dark), the same in every figure; a pruned
-    tree ``tree_n<N>_m<M>`` gets the ``pruned`` colour. Unknown names raise ``ValueError``."""
+    """Hex colour of ``method``: a scheme of :data:`METHOD_COLOURS`, or a UAV planning method
+    of any registered family (its :meth:`rsmhp.uav.methods.Method.shade`, the same in every
+    figure). Unknown names raise ``ValueError``."""
     name = str(method).lower()
     if name in METHOD_COLOURS:
         return METHOD_COLOURS[name]
-    m = _RSMHP.match(name)
-    if m:
-        nt = int(m.group(1))
-        return _RSMHP_SHADES[sum(nt > edge for edge in (10, 50, 100, 250))]
-    if _PRUNED.match(name):
-        return METHOD_COLOURS["pruned"]
-    raise ValueError(
-        f"method {method!r} has no colour (allowed: {sorted(METHOD_COLOURS)}, rsmhp_nt<N_T>, "
-        "tree_n<N>_m<M>)"
-    )
+    return _uav_method(method).shade()
+
+
+def _uav_method(method: str):
+    """The registered UAV planning method called ``method`` (``ValueError`` if none)."""
+    from rsmhp.uav import methods  # the registry imports this module: import on use
+
+    try:
+        return methods.from_name(str(method).lower())
+    except ValueError:
+        raise ValueError(
+            f"method {method!r} has no colour (allowed: {sorted(METHOD_COLOURS)}, or a "
+            "registered UAV method: rsmhp_nt<N_T>, tree_n<N>_m<M>, ...)"
+        ) from None
 
 
 def method_rgb(method: str) -> tuple[int, int, int]:
@@ -87,15 +85,10 @@ def method_rgb(method: str) -> tuple[int, int, int]:
 
 
 def method_label(method: str) -> str:
-    """Human-readable name: ``rsmhp_nt250`` -> ``RS-MHP N_T=250``, ``tree_n8_m100`` ->
-    ``pruned tree N=8 M=100``, ``nbo`` -> ``NBO``, ``mc`` -> ``MC (independent)``."""
+    """Human-readable name: ``nbo`` -> ``NBO``, ``mc`` -> ``MC (independent)``; a UAV method
+    as its family module says (``rsmhp_nt250`` -> ``RS-MHP N_T=250``, ``tree_n8_m100`` ->
+    ``pruned tree N=8 M=100``)."""
     name = str(method).lower()
-    m = _RSMHP.match(name)
-    if m:
-        return f"RS-MHP N_T={m.group(1)}"
-    m = _PRUNED.match(name)
-    if m:
-        return f"pruned tree N={m.group(1)} M={m.group(2)}"
     labels = {
         "nbo": "NBO",
         "mc": "MC (independent)",
@@ -111,4 +104,7 @@ def method_label(method: str) -> str:
     }
     if name in labels:
         return labels[name]
-    raise ValueError(f"method {method!r} has no label")
+    try:
+        return _uav_method(method).label()
+    except ValueError:
+        raise ValueError(f"method {method!r} has no label") from None

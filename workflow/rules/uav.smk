@@ -3,14 +3,13 @@
 # run takes about 0.1 s, less than starting a worker pool: parallelism comes from running the
 # method jobs side by side); then collection, aggregation (tables, report section), figures
 # and recordings as separate rules.
-import dataclasses
 import re
 
 from rsmhp.experiments.uav import UAV_MODEL_KEYS, chunk_runs
-from rsmhp.uav.simulation import method_specs
+from rsmhp.uav import methods as uav_methods
 
 UAV = config["uav"]
-UAV_SPECS = method_specs(UAV)
+UAV_SPECS = uav_methods.from_config(UAV["methods"], "uav.methods")
 UAV_METHODS = list(UAV_SPECS)
 UAV_CHUNKS = list(range(min(UAV["chunks"], UAV["runs"])))
 UAV_RECORDED = list(range(min(UAV["recording"]["runs"], UAV["runs"])))
@@ -51,7 +50,7 @@ rule uav_simulate:
         # the model, this method's own spec and this chunk's runs: adding an N_T value or a
         # figure option reruns no existing simulation
         uav=pick(UAV, *UAV_MODEL_KEYS),
-        method=lambda wc: dataclasses.asdict(UAV_SPECS[wc.method]),
+        method=lambda wc: UAV_SPECS[wc.method].spec(),
         runs=lambda wc: chunk_runs(UAV["runs"], len(UAV_CHUNKS), int(wc.chunk)),
         seed=config["seed"],
     script:
@@ -87,7 +86,7 @@ rule uav_collect:
     params:
         methods=UAV_METHODS,
         # each chunk is checked against what its simulation was asked for
-        specs={m: dataclasses.asdict(s) for m, s in UAV_SPECS.items()},
+        specs={m: s.spec() for m, s in UAV_SPECS.items()},
         runs=UAV["runs"],
         chunks=len(UAV_CHUNKS),
         steps=UAV["scenario"]["steps"],
@@ -167,7 +166,7 @@ rule uav_recording:
         runtime=10,
     params:
         uav=pick(UAV, *UAV_MODEL_KEYS),
-        methods=[dataclasses.asdict(s) for s in UAV_SPECS.values()],
+        methods=[s.spec() for s in UAV_SPECS.values()],
         max_hypotheses=UAV["recording"]["max_hypotheses"],
         seed=config["seed"],
     script:

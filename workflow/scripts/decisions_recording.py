@@ -1,5 +1,5 @@
-"""Rule decisions_recording: one closed-loop run of a model variant, NBO and the largest
-RS-MHP N_T side by side, the sensor footprint drawn at every step."""
+"""Rule decisions_recording: one closed-loop run of a model variant, NBO and the method with
+the most hypotheses side by side, the sensor footprint drawn at every step."""
 
 from rsmhp.experiments.decisions_uav import recording_setup
 from rsmhp.pipeline import rule_logging

@@ -1,14 +1,15 @@
 """Rule uav_recording: run k with every method side by side, as a rerun recording."""
 
 from rsmhp.pipeline import rule_logging
+from rsmhp.uav import methods
 from rsmhp.uav.recording import record_uav_run
-from rsmhp.uav.simulation import MethodSpec, UAVSetup
+from rsmhp.uav.simulation import UAVSetup
 
 with rule_logging(snakemake.log[0], snakemake.rule) as log:
     rows, _ = record_uav_run(
         snakemake.output[0],
         UAVSetup.from_config(snakemake.params.uav),
-        [MethodSpec(**m) for m in snakemake.params.methods],
+        [methods.from_spec(m) for m in snakemake.params.methods],
         seed=snakemake.params.seed,
         run=int(snakemake.wildcards.k),
         max_hypotheses=snakemake.params.max_hypotheses,

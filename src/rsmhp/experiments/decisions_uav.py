@@ -52,17 +52,10 @@ from threadpoolctl import threadpool_limits
 from rsmhp.contracts import Contract
 from rsmhp.parallel import parallel_map
 from rsmhp.seeding import job_rng
-from rsmhp.uav import fused, target
-from rsmhp.uav.planner import PlanningProblem, lbfgsb, plan
-from rsmhp.uav.simulation import (
-    MethodSpec,
-    StepInfo,
-    UAVSetup,
-    _hypotheses,
-    draw_scenario,
-    method_specs,
-    simulate_run,
-)
+from rsmhp.uav import fused, methods, target
+from rsmhp.uav.methods import Method
+from rsmhp.uav.planner import Belief, PlanningProblem, lbfgsb
+from rsmhp.uav.simulation import StepInfo, UAVSetup, draw_scenario, simulate_run
 
 __all__ = [
     "MAP_RUN_COLUMNS",
@@ -120,14 +113,14 @@ _REGRET_INTEGERS = ("run", "step", "N_T", "N", "M", "n_eval")
 _REGRET_NULLABLE = ("spearman_random", "spearman_local")
 
 
-def _regret_contract(rule: str, models: Sequence[str], runs: int, steps, methods) -> Contract:
+def _regret_contract(rule: str, models: Sequence[str], runs: int, steps, method_cfg) -> Contract:
     names = ["model", "run", "step", "method"]
     keys = [
         (m, r, k, name)
         for m in models
         for r in range(int(runs))
         for k in sorted({int(s) for s in steps})
-        for name in method_specs({"methods": methods})
+        for name in methods.from_config(method_cfg)
     ]
     return Contract(
         rule=rule,
@@ -156,7 +149,7 @@ def map_contracts(cfg: Mapping[str, Any], cell: str) -> tuple[Contract, Contract
     names = {c.name: c for c in map_cells(cfg)}
     if cell not in names:
         raise ValueError(f"unknown map cell {cell!r}; cells: {', '.join(names)}")
-    keys = [(m, r) for m in method_specs({"methods": cfg["methods"]}) for r in range(cfg["runs"])]
+    keys = [(m, r) for m in methods.from_config(cfg["methods"]) for r in range(cfg["runs"])]
     runs = Contract(
         rule="decisions_map_cell",
         columns=MAP_RUN_COLUMNS,
@@ -206,7 +199,8 @@ class BeliefState:
 def belief_states(
     setup: UAVSetup, model: str, seed: int, runs: Sequence[int], steps: Sequence[int]
 ) -> list[BeliefState]:
-    """Belief states of closed-loop NBO runs ``runs`` at ``steps`` (0 = the initial belief)."""
+    """Belief states of closed-loop runs of the baseline method (NBO) ``runs`` at ``steps``
+    (0 = the initial belief)."""
     H = setup.planner.horizon
     wanted = sorted(set(int(s) for s in steps))
     if wanted and wanted[-1] >= setup.steps:
@@ -214,7 +208,7 @@ def belief_states(
             f"belief-state step {wanted[-1]} (decisions.uav.steps / decisions.map.regret_steps) "
             f"is not before the run's last step (uav.scenario.steps = {setup.steps})"
         )
-    nbo = MethodSpec("nbo", "nbo", 1)
+    base = methods.baseline()()
     out: list[BeliefState] = []
     for run in runs:
         got: dict[int, BeliefState] = {}
@@ -237,7 +231,7 @@ def belief_states(
                     )
 
             short = dataclasses.replace(setup, steps=max(later))
-            simulate_run(short, nbo, seed, run, observer=observe)
+            simulate_run(short, base, seed, run, observer=observe)
         out.extend(got[k] for k in wanted)
     return out
 
@@ -249,11 +243,11 @@ def _positions(x: np.ndarray, problem: PlanningProblem) -> np.ndarray:
 def score_state(
     state: BeliefState,
     setup: UAVSetup,
-    methods: Mapping[str, MethodSpec],
+    planners: Mapping[str, Method],
     cfg: Mapping[str, Any],
     seed: int,
 ) -> list[dict[str, Any]]:
-    """One row per method (see the module docstring)."""
+    """One row per method of ``planners`` (see the module docstring)."""
     H = setup.planner.horizon
     ident = {"model": state.model, "run": state.run, "step": state.step}
     eval_rng = job_rng(seed, "decisions_uav_eval", **ident)
@@ -264,12 +258,17 @@ def score_state(
     args = (setup.uav, setup.target, setup.sensor, setup.planner)
     ev = PlanningProblem(state.uav, state.P_hat, eval_xy, *args)
     plans: dict[str, tuple[np.ndarray, float, PlanningProblem]] = {}
-    for name, spec in methods.items():
-        rng = job_rng(seed, "decisions_uav_plan", **ident, **spec.job_params())
-        hyp = _hypotheses(spec, state.x_hat, state.P_hat, setup, rng)
-        prob = PlanningProblem(state.uav, state.P_hat, hyp[..., :2], *args)
-        res = plan(prob, state.warm)
-        plans[name] = (res.controls.ravel() / prob.scale, res.cost, prob)
+    belief = Belief(state.uav, state.x_hat, state.P_hat)
+    scale = np.tile(setup.uav.control_scale, H)
+    for name, method in planners.items():
+        rng = job_rng(seed, "decisions_uav_plan", **ident, **method.job_key())
+        res = method.planner(setup).plan(belief, state.warm, rng)
+        # the method's own cost of any plan (rank agreement); NaN-free only with hypotheses
+        hyp = res.hypotheses
+        prob = PlanningProblem(
+            state.uav, state.P_hat, hyp.states[..., :2], *args, weights=hyp.weights
+        )
+        plans[name] = (res.controls.ravel() / scale, res.cost, prob)
     # reference: multi-start L-BFGS-B on the evaluation cost
     aux = job_rng(seed, "decisions_uav_aux", **ident)
     cands = np.array([p[0] for p in plans.values()])
@@ -296,17 +295,15 @@ def score_state(
     ev_rand, ev_local = ev.costs(rand), ev.costs(local)
     rows = []
     for k, (name, (_, own, prob)) in enumerate(plans.items()):
-        spec = methods[name]
+        method = planners[name]
         diff = per_hyp[k] - best_c
         rows.append(
             {
                 **ident,
                 "trace_P": float(np.trace(state.P_hat)),
                 "method": name,
-                "family": spec.family,
-                "N_T": spec.n_traj,
-                "N": spec.n_branch or 0,
-                "M": spec.max_keep or 0,
+                "family": method.family,
+                **method.columns(),
                 "plan_cost": own,
                 "eval_cost": float(per_hyp[k].mean()),
                 "eval_se": float(per_hyp[k].std(ddof=1) / np.sqrt(n_eval)),
@@ -334,9 +331,9 @@ def _spearman(a: np.ndarray, b: np.ndarray) -> float:
 def _score_task(job) -> list[dict[str, Any]]:
     states, uav_cfg, methods_cfg, cfg, seed = job
     setup = UAVSetup.from_config(uav_cfg)
-    methods = method_specs({"methods": methods_cfg})
+    planners = methods.from_config(methods_cfg)
     with threadpool_limits(limits=1):
-        return [row for st in states for row in score_state(st, setup, methods, cfg, seed)]
+        return [row for st in states for row in score_state(st, setup, planners, cfg, seed)]
 
 
 def run_uav_regret(
@@ -362,7 +359,7 @@ def run_uav_regret(
     log.info(
         "decisions_uav: %d belief states x %d methods in %d tasks on %d workers",
         n_states,
-        len(method_specs({"methods": cfg["methods"]})),
+        len(methods.from_config(cfg["methods"])),
         len(jobs),
         n_jobs,
     )
@@ -427,9 +424,9 @@ def run_map_cell(
         raise ValueError(f"unknown map cell {cell_name!r}; cells: {', '.join(cells)}")
     cell = cells[cell_name]
     uav_cfg = merge_variant(uav, cell.variant)
-    methods = method_specs({"methods": cfg["methods"]})
+    planners = methods.from_config(cfg["methods"])
     runs = list(range(int(cfg["runs"])))
-    jobs = [(uav_cfg, methods[m], seed, r) for m in methods for r in runs]
+    jobs = [(uav_cfg, planners[m], seed, r) for m in planners for r in runs]
     log.info("map cell %s (%s): %d closed-loop runs", cell.name, cell.variant, len(jobs))
     summaries = parallel_map(_closed_loop_task, jobs, n_jobs, desc=f"cell {cell.name} runs")
     loss = float(cfg["track_loss_error"])
@@ -469,19 +466,20 @@ def _closed_loop_task(job) -> dict[str, Any]:
 def recording_setup(
     uav: Mapping[str, Any],
     models: Sequence[Mapping[str, Any]],
-    methods: Mapping[str, Any],
+    method_cfg: Mapping[str, Any],
     model: str,
-) -> tuple[UAVSetup, list[MethodSpec]]:
+) -> tuple[UAVSetup, list[Method]]:
     """The setup of model variant ``model`` of ``models`` and the methods a decision
-    recording shows: NBO and RS-MHP with the largest N_T of ``methods``."""
+    recording shows: the baseline (NBO) and the configured method that averages over the most
+    hypotheses (ties: the later one in table order; the default config: RS-MHP N_T=250)."""
     variants = {m["name"]: m for m in models}
     if model not in variants:
         raise ValueError(
             f"decisions.recording.model: {model!r} is not one of {', '.join(variants)}"
         )
     setup = UAVSetup.from_config(merge_variant(uav, variants[model]))
-    specs = [MethodSpec("nbo", "nbo", 1)]
-    if methods.get("rsmhp_nt"):
-        n = max(int(v) for v in methods["rsmhp_nt"])
-        specs.append(MethodSpec(f"rsmhp_nt{n}", "rsmhp", n))
-    return setup, specs
+    base = methods.baseline()()
+    others = [m for m in methods.from_config(method_cfg).values() if m.family != base.family]
+    if not others:
+        return setup, [base]
+    return setup, [base, max(others, key=lambda m: (m.n_traj, m.sort_key()))]

@@ -16,7 +16,9 @@ import pandas as pd
 
 from rsmhp.contracts import Contract
 from rsmhp.parallel import chunked, parallel_map
-from rsmhp.uav.simulation import MethodSpec, UAVSetup, simulate_run
+from rsmhp.uav import methods
+from rsmhp.uav.methods import Method
+from rsmhp.uav.simulation import UAVSetup, simulate_run
 
 __all__ = [
     "NONDETERMINISTIC_COLUMNS",
@@ -102,12 +104,13 @@ def runs_contract(methods: Sequence[str], n_runs: int, seed: int) -> Contract:
 
 
 def chunk_contracts(
-    method: MethodSpec | Mapping[str, Any], runs: Sequence[int], steps: int, seed: int
+    method: Method | Mapping[str, Any], runs: Sequence[int], steps: int, seed: int
 ) -> tuple[Contract, Contract]:
     """What one chunk's runs CSV and steps Parquet (rule ``uav_simulate``) must hold: the
-    runs ``runs`` of ``method``, each with steps ``1..steps``."""
-    if not isinstance(method, MethodSpec):
-        method = MethodSpec(**method)
+    runs ``runs`` of ``method`` (a registered method or its spec), each with steps
+    ``1..steps``."""
+    if not isinstance(method, Method):
+        method = methods.from_spec(method)
     runs = [int(r) for r in runs]
     fixed = {"method": method.name, "N_T": method.n_traj}
     run_c = Contract(
@@ -132,7 +135,7 @@ def chunk_contracts(
     return run_c, step_c
 
 
-def _one_run(job: tuple[Mapping[str, Any], MethodSpec, int, int]) -> tuple[dict, list[dict]]:
+def _one_run(job: tuple[Mapping[str, Any], Method, int, int]) -> tuple[dict, list[dict]]:
     uav, method, seed, run = job
     summary, steps = simulate_run(UAVSetup.from_config(uav), method, seed, run)
     for row in steps:
@@ -142,15 +145,16 @@ def _one_run(job: tuple[Mapping[str, Any], MethodSpec, int, int]) -> tuple[dict,
 
 def run_chunk(
     uav: Mapping[str, Any],
-    method: MethodSpec | Mapping[str, Any],
+    method: Method | Mapping[str, Any],
     runs: Sequence[int],
     seed: int,
     n_jobs: int = 1,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """Simulate ``runs`` with ``method`` (a :class:`MethodSpec` or its fields as a mapping):
-    (runs, steps) tables. ``uav`` needs the model sections only (not ``methods``)."""
-    if not isinstance(method, MethodSpec):
-        method = MethodSpec(**method)
+    """Simulate ``runs`` with ``method`` (a registered :class:`rsmhp.uav.methods.Method` or its
+    :meth:`~rsmhp.uav.methods.Method.spec`): (runs, steps) tables. ``uav`` needs the model
+    sections only (not ``methods``)."""
+    if not isinstance(method, Method):
+        method = methods.from_spec(method)
     jobs = [(dict(uav), method, seed, int(r)) for r in runs]
     log.info("uav %s: %d runs on %d workers", method.name, len(jobs), n_jobs)
     out = parallel_map(_one_run, jobs, n_jobs, desc=f"uav {method.name} runs")

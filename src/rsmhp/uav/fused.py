@@ -70,12 +70,14 @@ __all__ = [
     "Frozen",
     "check_frozen",
     "check_uav_state",
+    "check_weights",
     "cost",
     "cost_and_grad",
     "covariance_traces",
     "evaluate",
     "path",
     "warm_up",
+    "weight_args",
 ]
 
 
@@ -230,11 +232,6 @@ def _sub(a, b):  # pragma: no cover - compiled
 
 
 @njit(cache=True, inline="always")
-def _add(a, b):  # pragma: no cover - compiled
-    return (a[0] + b[0], a[1] + b[1], a[2] + b[2], a[3] + b[3])
-
-
-@njit(cache=True, inline="always")
 def _adjoint_step(ga, gb, gc, m, n, dt, pd, limited):  # pragma: no cover - compiled
     r"""Given G = [[Ga, Gb], [Gb^T, Gc]] = dJ/dP^+ (2x2 blocks as row-major 4-tuples), return
     (Rbar = K^T G K, and the blocks of F^T (E^T G E) F), with K = [M^T; N^T], E = I - K H.
@@ -364,7 +361,7 @@ def _path_kernel(xc, state0, scale, dt, g, smin, smax, out):  # pragma: no cover
 
 @njit(cache=True, nogil=True)
 def _cost_grad_kernel(
-    x, state0, scale, uav_dt, g, smin, smax, p0, txy, tdt, q, sens, want_grad, cost, grad
+    x, state0, scale, uav_dt, g, smin, smax, p0, txy, wts, norm, tdt, q, sens, want_grad, cost, grad
 ):  # pragma: no cover - compiled
     n_c = x.shape[0]
     horizon = x.shape[1] // 2
@@ -387,6 +384,7 @@ def _cost_grad_kernel(
             gxy[j, 0] = 0.0
             gxy[j, 1] = 0.0
         for i in range(n_t):
+            wi = wts[i]
             p = p0
             acc = 0.0
             for j in range(horizon):
@@ -402,7 +400,7 @@ def _cost_grad_kernel(
                         det[j, 0], det[j, 1], det[j, 2] = pd, dpx, dpy
                         for e in range(10):
                             det[j, 3 + e] = xk[e]
-            total += acc
+            total += wi * acc
             if want_grad:
                 ga = (1.0, 0.0, 0.0, 1.0)
                 gb = (0.0, 0.0, 0.0, 0.0)
@@ -429,24 +427,24 @@ def _cost_grad_kernel(
                             + (gc[1] + gc[2]) * det[j, 11]
                             + gc[3] * det[j, 12]
                         )
-                        gxy[j, 0] += pbar * det[j, 1]
-                        gxy[j, 1] += pbar * det[j, 2]
+                        gxy[j, 0] += wi * (pbar * det[j, 1])
+                        gxy[j, 1] += wi * (pbar * det[j, 2])
                     rbar, ga, gb, gc = _adjoint_step(ga, gb, gc, m, n, tdt, pd, limited)
                     ga = (ga[0] + 1.0, ga[1], ga[2], ga[3] + 1.0)
                     gc = (gc[0] + 1.0, gc[1], gc[2], gc[3] + 1.0)
                     gx, gy = _meas_cov_grad(
                         uxy[j, 0], uxy[j, 1], txy[i, j, 0], txy[i, j, 1], rbar, sens
                     )
-                    gxy[j, 0] += gx
-                    gxy[j, 1] += gy
-        cost[c] = total / n_t
+                    gxy[j, 0] += wi * gx
+                    gxy[j, 1] += wi * gy
+        cost[c] = total / norm
         if not want_grad:
             continue
         # ---- kinematics adjoint: (bpx, bpy, bs, bpsi) = dJ/d(state after step j)
         bpx = bpy = bs = bpsi = 0.0
         for j in range(horizon - 1, -1, -1):
-            bpx += gxy[j, 0] / n_t
-            bpy += gxy[j, 1] / n_t
+            bpx += gxy[j, 0] / norm
+            bpy += gxy[j, 1] / norm
             s_new, h_new = spd[j + 1], hdg[j + 1]
             ch, sh = np.cos(h_new), np.sin(h_new)
             bs_new = bs + uav_dt * (bpx * ch + bpy * sh)
@@ -550,6 +548,27 @@ def check_frozen(
     guards.instance_of("sensor", sensor, SensorModel)
 
 
+def check_weights(weights: np.ndarray, n: int) -> np.ndarray:
+    """Hypothesis weights: finite (n,), every entry >= 0, summing to 1 within 1e-9."""
+    w = guards.finite_array("weights", weights, shape=(n,))
+    if (w < 0).any():
+        raise ValueError(f"weights must be >= 0, got min {w.min()}")
+    if abs(w.sum() - 1.0) > 1e-9:
+        raise ValueError(f"weights must sum to 1 (within 1e-9), got sum {w.sum()!r}")
+    return w
+
+
+def weight_args(weights: np.ndarray | None, n: int) -> tuple[np.ndarray, float]:
+    """The kernel's (per-hypothesis factors (n,), divisor): equal weights (``None``, or all
+    entries equal) give (ones, n), the arithmetic of the plain average; others (w, 1)."""
+    if weights is None:
+        return np.ones(n), float(n)
+    w = np.ascontiguousarray(weights, dtype=float)
+    if w.size and (w == w[0]).all():
+        return np.ones(n), float(n)
+    return w, 1.0
+
+
 def check_uav_state(uav_state: np.ndarray) -> None:
     """A UAV state ``(p_x, p_y, s, psi)``: finite (4,), speed ``s`` > 0 (the turn rate
     divides by it)."""
@@ -562,7 +581,7 @@ def check_uav_state(uav_state: np.ndarray) -> None:
 
 class Frozen:
     """The arguments that stay fixed during one planning step (UAV state, aircraft, posterior,
-    hypotheses, target model, sensor), converted once for :func:`evaluate`.
+    hypotheses and their weights, target model, sensor), converted once for :func:`evaluate`.
 
     Checked by :func:`check_frozen` unless ``check=False`` (for callers that checked them,
     e.g. :class:`rsmhp.uav.planner.PlanningProblem`; :func:`evaluate`, called for every
@@ -571,10 +590,23 @@ class Frozen:
     __slots__ = ("args",)
 
     def __init__(
-        self, uav_state, uav, P0, target_xy, target_dt, Q, sensor, *, check: bool = True
+        self,
+        uav_state,
+        uav,
+        P0,
+        target_xy,
+        target_dt,
+        Q,
+        sensor,
+        *,
+        weights: np.ndarray | None = None,
+        check: bool = True,
     ) -> None:
         if check:
             check_frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor)
+            if weights is not None:
+                weights = check_weights(weights, np.shape(target_xy)[0])
+        wts, norm = weight_args(weights, np.shape(target_xy)[0])
         self.args = (
             np.ascontiguousarray(uav_state, dtype=float),
             np.array([uav.accel_max, uav.bank_max]),
@@ -584,6 +616,8 @@ class Frozen:
             float(uav.speed_max),
             _entries(np.asarray(P0, dtype=float)),
             np.ascontiguousarray(target_xy, dtype=float),
+            wts,
+            norm,
             float(target_dt),
             _entries(np.asarray(Q, dtype=float)),
             _sensor_args(sensor),
@@ -598,11 +632,27 @@ def evaluate(x: np.ndarray, frozen: Frozen, want_grad: bool) -> tuple[np.ndarray
     n_c = x.shape[0]
     cost_out = np.empty(n_c)
     grad_out = np.empty((n_c, x.shape[1]) if want_grad else (0, 0))
-    st, sc, udt, g, smin, smax, p0, txy, tdt, q, sens = frozen.args
+    st, sc, udt, g, smin, smax, p0, txy, wts, norm, tdt, q, sens = frozen.args
     if txy.shape[1] != x.shape[1] // 2:
         raise ValueError(f"target_xy has {txy.shape[1]} steps, x has {x.shape[1] // 2}")
     return _cost_grad_kernel(
-        x, st, sc, udt, g, smin, smax, p0, txy, tdt, q, sens, want_grad, cost_out, grad_out
+        x,
+        st,
+        sc,
+        udt,
+        g,
+        smin,
+        smax,
+        p0,
+        txy,
+        wts,
+        norm,
+        tdt,
+        q,
+        sens,
+        want_grad,
+        cost_out,
+        grad_out,
     )
 
 
@@ -628,11 +678,13 @@ def cost_and_grad(
     target_dt: float,
     Q: np.ndarray,
     sensor: SensorModel,
+    weights: np.ndarray | None = None,
 ) -> tuple[np.ndarray, np.ndarray]:
     r"""Planner cost :math:`J` (C,) and exact gradient :math:`\nabla_x J` (C, 2H) of normalised
     control sequences ``x`` (C, 2H) from UAV state ``uav_state`` (4,), posterior ``P0`` (4, 4)
-    and hypotheses ``target_xy`` (T, H, 2) (m², per unit of normalised control)."""
-    frozen = Frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor)
+    and hypotheses ``target_xy`` (T, H, 2) with ``weights`` (T,) (``None``: equal) (m², per
+    unit of normalised control)."""
+    frozen = Frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor, weights=weights)
     return evaluate(_controls(x, frozen), frozen, True)
 
 
@@ -645,9 +697,10 @@ def cost(
     target_dt: float,
     Q: np.ndarray,
     sensor: SensorModel,
+    weights: np.ndarray | None = None,
 ) -> np.ndarray:
     """Planner cost only (C,) (see :func:`cost_and_grad`)."""
-    frozen = Frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor)
+    frozen = Frozen(uav_state, uav, P0, target_xy, target_dt, Q, sensor, weights=weights)
     return evaluate(_controls(x, frozen), frozen, False)[0]
 
 
@@ -662,7 +715,7 @@ def _controls(x: np.ndarray, frozen: Frozen) -> np.ndarray:
 
 def warm_up() -> float:
     """Compile (or load from the cache) every kernel, the planner's and the hypothesis
-    tree's (:func:`rsmhp.uav.target.sample_tree`); returns the seconds it took."""
+    tree's (:func:`rsmhp.uav.target.pruned_tree`); returns the seconds it took."""
     import time
 
     from rsmhp.uav import target
@@ -678,5 +731,5 @@ def warm_up() -> float:
     path(np.zeros(4), frozen)
     # the variants run the same compiled code (flags are runtime values), nothing to add
     model = target.TargetModel(1.0, 1.0)
-    target.sample_tree(np.zeros(4), eye, 1, 2, 1, model, np.random.default_rng(0))
+    target.pruned_tree(np.zeros(4), eye, 1, 2, 1, model, np.random.default_rng(0))
     return time.perf_counter() - t0

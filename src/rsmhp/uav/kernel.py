@@ -185,7 +185,13 @@ def objective(
     dt: float,
     Q: np.ndarray,
     sensor: SensorModel,
+    weights: np.ndarray | None = None,
 ) -> np.ndarray:
-    r"""Cost per candidate (C,): :math:`\frac1T\sum_{i=1}^T\sum_{j=1}^H \mathrm{tr} P_j^{c,i}`
-    (m² + m²/s², summed as the paper's trace)."""
-    return covariance_traces(P0, uav_xy, target_xy, dt, Q, sensor).sum(axis=2).mean(axis=1)
+    r"""Cost per candidate (C,): :math:`\sum_{i=1}^T \omega_i \sum_{j=1}^H \mathrm{tr}
+    P_j^{c,i}` (m² + m²/s², summed as the paper's trace), with hypothesis weights ``weights``
+    (T,) summing to 1; ``None``: :math:`\omega_i = 1/T`."""
+    per_hyp = covariance_traces(P0, uav_xy, target_xy, dt, Q, sensor).sum(axis=2)
+    if weights is None:
+        return per_hyp.mean(axis=1)
+    w = guards.finite_array("weights", weights, shape=(np.shape(target_xy)[0],))
+    return per_hyp @ w

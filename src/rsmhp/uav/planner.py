@@ -3,10 +3,21 @@ r"""Receding-horizon planner: minimise the batched covariance cost over an H-ste
 Decision variable: normalised controls :math:`x \in [-1, 1]^{2H}`, mapped to
 :math:`u_j = (a_{\max} x_{2j}, \phi_{\max} x_{2j+1})`. Objective (:mod:`rsmhp.uav.kernel`):
 
-.. math:: J(u) = \frac{1}{N_T} \sum_{i=1}^{N_T} \sum_{j=1}^{H} \mathrm{tr}\, P_j^i(u)
+.. math:: J(u) = \sum_{i=1}^{N_T} \omega_i \sum_{j=1}^{H} \mathrm{tr}\, P_j^i(u)
 
-for fixed target hypotheses (NBO: the single nominal one; RS-MHP: N_T samples drawn once per
-planning step, i.e. common random numbers across every evaluation of the optimisation).
+for fixed, weighted target hypotheses (:class:`rsmhp.uav.methods.Hypotheses`; NBO: the single
+nominal one; RS-MHP: N_T samples of weight 1/N_T drawn once per planning step, i.e. common
+random numbers across every evaluation of the optimisation).
+
+Two protocols separate what a method decides from how it optimises:
+
+* :class:`Planner`: plans one :class:`Belief` (UAV state, target estimate and covariance)
+  from a warm start and returns a :class:`PlanResult` (controls and diagnostics). The closed
+  loop and the decision study only call this; a method that is not "hypotheses + optimiser"
+  (e.g. a tree search) implements it directly.
+* :class:`Optimiser`: minimises a :class:`PlanningProblem` (a fixed weighted cost) from a
+  start; :class:`LBFGSB` (scipy) is today's. :class:`SampledCostPlanner` combines a method's
+  hypotheses with an optimiser: the planner of every sampling method.
 
 Value and exact gradient :math:`\nabla_x J` come from one call of the compiled kernel
 :func:`rsmhp.uav.fused.cost_and_grad` (adjoint of the covariance recursion and of the
@@ -19,9 +30,9 @@ zeros at the first step).
 from __future__ import annotations
 
 import functools
-from collections.abc import Mapping
-from dataclasses import dataclass
-from typing import Any
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import Any, Protocol, runtime_checkable
 
 import numpy as np
 from scipy.optimize import Bounds, minimize
@@ -32,7 +43,19 @@ from rsmhp.uav.kinematics import UAVParams
 from rsmhp.uav.sensor import SensorModel
 from rsmhp.uav.target import TargetModel
 
-__all__ = ["PlanResult", "PlannerParams", "PlanningProblem", "lbfgsb", "plan", "shift_plan"]
+__all__ = [
+    "LBFGSB",
+    "Belief",
+    "Optimiser",
+    "PlanResult",
+    "Planner",
+    "PlannerParams",
+    "PlanningProblem",
+    "SampledCostPlanner",
+    "lbfgsb",
+    "plan",
+    "shift_plan",
+]
 
 
 @dataclass(frozen=True)
@@ -57,7 +80,9 @@ class PlannerParams:
 
 @dataclass
 class PlanResult:
-    """Optimised controls (H, 2), their cost, the warm start's cost, optimiser counters."""
+    """Optimised controls (H, 2), their cost, the warm start's cost, optimiser counters, the
+    planned UAV states (H, 4) and the hypotheses the cost averaged over (``None`` for a
+    planner without hypotheses); ``diagnostics`` holds planner-specific numbers."""
 
     controls: np.ndarray
     cost: float
@@ -65,6 +90,36 @@ class PlanResult:
     nit: int
     n_kernel_calls: int
     uav_path: np.ndarray  # (H, 4) planned UAV states
+    hypotheses: Any = None  # rsmhp.uav.methods.Hypotheses
+    diagnostics: dict[str, float] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class Belief:
+    """What a planner sees at one step: UAV state (4,) ``(p_x, p_y, s, psi)``, the tracker's
+    target estimate ``x_hat`` (4,) and covariance ``P_hat`` (4, 4)."""
+
+    uav: np.ndarray
+    x_hat: np.ndarray
+    P_hat: np.ndarray
+
+
+@runtime_checkable
+class Planner(Protocol):
+    """Plans one belief state: ``plan(belief, warm_start (H, 2), rng) -> PlanResult``. ``rng``
+    is the step's own stream (``job_rng(seed, ..., step=k, **method.job_key())``); a planner
+    draws every random number it needs from it."""
+
+    def plan(
+        self, belief: Belief, warm_start: np.ndarray, rng: np.random.Generator
+    ) -> PlanResult: ...
+
+
+@runtime_checkable
+class Optimiser(Protocol):
+    """Minimises a :class:`PlanningProblem` from ``warm_start`` (H, 2) controls."""
+
+    def minimise(self, problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult: ...
 
 
 class PlanningProblem:
@@ -75,8 +130,9 @@ class PlanningProblem:
 
     The arguments are checked once here (``uav_state`` finite (4,) with speed > 0, ``P_hat``
     finite symmetric positive semidefinite (4, 4), ``target_xy`` finite (T, H, 2) with
-    T >= 1 and H the planner's horizon, and the model types), never per evaluation;
-    ``check=False`` skips this (the closed loop checks its inputs once per run).
+    T >= 1 and H the planner's horizon, ``weights`` (T,) >= 0 summing to 1 or ``None`` for
+    equal weights, and the model types), never per evaluation; ``check=False`` skips this
+    (the closed loop checks its inputs once per run).
     """
 
     def __init__(
@@ -89,6 +145,7 @@ class PlanningProblem:
         sensor: SensorModel,
         params: PlannerParams,
         *,
+        weights: np.ndarray | None = None,
         check: bool = True,
     ) -> None:
         if check:
@@ -100,6 +157,8 @@ class PlanningProblem:
             guards.spd_matrix("P_hat", P_hat, semi=True, size=4)
             H = params.horizon
             guards.finite_array("target_xy", target_xy, shape=("T", H, 2), nonempty=True)
+            if weights is not None:
+                weights = fused.check_weights(weights, np.shape(target_xy)[0])
         self.uav_state = np.asarray(uav_state, dtype=float)
         self.P_hat = np.asarray(P_hat, dtype=float)
         self.target_xy = np.asarray(target_xy, dtype=float)
@@ -115,6 +174,7 @@ class PlanningProblem:
             target.dt,
             target.Q,
             sensor,
+            weights=weights,
             check=False,
         )
 
@@ -206,3 +266,43 @@ def plan(problem: PlanningProblem, warm_start: np.ndarray, *, check: bool = True
         n_kernel_calls=problem.n_kernel_calls,
         uav_path=problem.path(x_best),
     )
+
+
+@dataclass(frozen=True)
+class LBFGSB:
+    """Today's optimiser: scipy's L-BFGS-B with the exact gradient over the box, at most
+    ``params.maxiter`` iterations and ``params.maxfun`` evaluations (see :func:`plan`)."""
+
+    def minimise(self, problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
+        return plan(problem, warm_start, check=False)
+
+
+@dataclass(frozen=True)
+class SampledCostPlanner:
+    """The planner of every sampling method: draw the method's weighted hypotheses for the
+    belief (``draw(belief, rng)``), build the weighted cost and minimise it with
+    ``optimiser`` from the warm start."""
+
+    draw: Callable[[Belief, np.random.Generator], Any]
+    uav: UAVParams
+    target: TargetModel
+    sensor: SensorModel
+    params: PlannerParams
+    optimiser: Optimiser = LBFGSB()
+
+    def plan(self, belief: Belief, warm_start: np.ndarray, rng: np.random.Generator) -> PlanResult:
+        hyp = self.draw(belief, rng)
+        problem = PlanningProblem(
+            belief.uav,
+            belief.P_hat,
+            hyp.states[..., :2],
+            self.uav,
+            self.target,
+            self.sensor,
+            self.params,
+            weights=hyp.weights,
+            check=False,
+        )
+        res = self.optimiser.minimise(problem, warm_start)
+        res.hypotheses = hyp
+        return res

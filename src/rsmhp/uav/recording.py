@@ -40,7 +40,8 @@ import rerun.blueprint as rrb
 from rsmhp import guards
 from rsmhp.palette import method_rgb
 from rsmhp.seeding import canonical_job_id
-from rsmhp.uav.simulation import MethodSpec, StepInfo, UAVSetup, draw_scenario, simulate_run
+from rsmhp.uav.methods import Method
+from rsmhp.uav.simulation import StepInfo, UAVSetup, draw_scenario, simulate_run
 
 __all__ = ["EST_C", "TRUE_C", "ellipse_polygon", "record_uav_run", "uav_blueprint"]
 
@@ -129,7 +130,7 @@ def uav_blueprint(methods: list[str]) -> rrb.Blueprint:
 def record_uav_run(
     path: str | os.PathLike,
     setup: UAVSetup,
-    methods: list[MethodSpec],
+    methods: list[Method],
     seed: int,
     run: int,
     max_hypotheses: int = 50,
@@ -142,9 +143,9 @@ def record_uav_run(
     guards.instance_of("setup", setup, UAVSetup)
     methods = list(methods)
     if not methods:
-        raise ValueError("methods must name at least one MethodSpec, got none")
+        raise ValueError("methods must name at least one planning method, got none")
     for i, m in enumerate(methods):
-        guards.instance_of(f"methods[{i}]", m, MethodSpec)
+        guards.instance_of(f"methods[{i}]", m, Method)
     seed = guards.nonneg_int("seed", seed)
     run = guards.nonneg_int("run", run)
     max_hypotheses = guards.nonneg_int("max_hypotheses", max_hypotheses)

@@ -25,8 +25,10 @@ Run ``r`` (paired design: identical for every method)
 Planner hypotheses (method-specific)
 ------------------------------------
 At step k the planner's hypotheses come from
-``job_rng(seed, "uav_plan", run=r, step=k, method=<name>, N_T=..., N=..., M=...)``:
-drawn once per planning step and held fixed during the optimisation.
+``job_rng(seed, "uav_plan", run=r, step=k, **method.job_key())`` (the method's name and its
+N_T, N, M): drawn once per planning step and held fixed during the optimisation. The loop only
+calls the method's planner (:meth:`rsmhp.uav.methods.Method.planner`), so any registered
+method runs in it unchanged.
 
 Step k = 1..K
 -------------
@@ -52,91 +54,21 @@ from threadpoolctl import threadpool_limits
 
 from rsmhp import guards
 from rsmhp.seeding import job_rng
-from rsmhp.uav import kinematics, sensor, target
+from rsmhp.uav import kinematics, sensor
 from rsmhp.uav.kinematics import UAVParams
-from rsmhp.uav.planner import PlannerParams, PlanningProblem, plan, shift_plan
+from rsmhp.uav.methods import Method
+from rsmhp.uav.planner import Belief, PlannerParams, shift_plan
 from rsmhp.uav.sensor import SensorModel
 from rsmhp.uav.target import TargetModel
 from rsmhp.uav.tracker import Tracker
 
 __all__ = [
-    "MethodSpec",
     "Scenario",
     "StepInfo",
     "UAVSetup",
     "draw_scenario",
-    "method_specs",
     "simulate_run",
 ]
-
-FAMILIES = ("nbo", "rsmhp", "tree")
-
-
-@dataclass(frozen=True)
-class MethodSpec:
-    """A planning method: ``family`` in {nbo, rsmhp, tree}; ``n_traj`` = N_T (trajectories the
-    cost averages over: 1 for NBO, N_T for RS-MHP, M for the pruned tree)."""
-
-    name: str
-    family: str
-    n_traj: int
-    n_branch: int | None = None
-    max_keep: int | None = None
-
-    def __post_init__(self) -> None:
-        if not isinstance(self.name, str):
-            raise TypeError(
-                f"MethodSpec.name must be a non-empty string, got {type(self.name).__name__} "
-                f"{self.name!r}"
-            )
-        if not self.name:
-            raise ValueError("MethodSpec.name must be a non-empty string, got ''")
-        guards.one_of("MethodSpec.family", self.family, FAMILIES)
-        # whole-number floats become ints (1.0 and 1 already name the same random streams)
-        n_traj = guards.positive_int("MethodSpec.n_traj (N_T)", self.n_traj)
-        object.__setattr__(self, "n_traj", n_traj)
-        if self.family == "nbo" and n_traj != 1:
-            raise ValueError(
-                f"MethodSpec.n_traj (N_T) must be 1 for the nbo family (one nominal "
-                f"hypothesis), got {n_traj}"
-            )
-        for attr, label in (("n_branch", "N"), ("max_keep", "M")):
-            value = getattr(self, attr)
-            name = f"MethodSpec.{attr} ({label})"
-            if self.family == "tree":
-                if value is None:
-                    raise ValueError(
-                        f"{name} must be an integer >= 1 for the tree family, got None"
-                    )
-                object.__setattr__(self, attr, guards.positive_int(name, value))
-            elif value is not None:
-                raise ValueError(
-                    f"{name} must be None for the {self.family} family (only the tree uses it), "
-                    f"got {value!r}"
-                )
-
-    def job_params(self) -> dict[str, Any]:
-        """The method's part of a job identifier."""
-        return {"method": self.name, "N_T": self.n_traj, "N": self.n_branch, "M": self.max_keep}
-
-
-def method_specs(uav: Mapping[str, Any]) -> dict[str, MethodSpec]:
-    """Methods of the ``uav.methods`` config section, keyed by name (the rule wildcard):
-    ``nbo``, ``rsmhp_nt<N_T>`` for each N_T, ``tree_n<N>_m<M>`` for each tree ablation."""
-    m = uav["methods"]
-    guards.instance_of("uav.methods.nbo", m["nbo"], (bool, np.bool_))
-    out: dict[str, MethodSpec] = {}
-    if m["nbo"]:
-        out["nbo"] = MethodSpec("nbo", "nbo", 1)
-    for i, n in enumerate(m["rsmhp_nt"]):
-        n = guards.positive_int(f"uav.methods.rsmhp_nt[{i}]", n)
-        out[f"rsmhp_nt{n}"] = MethodSpec(f"rsmhp_nt{n}", "rsmhp", int(n))
-    for i, t in enumerate(m["tree"]):
-        N = guards.positive_int(f"uav.methods.tree[{i}].N", t["N"])
-        M = guards.positive_int(f"uav.methods.tree[{i}].M", t["M"])
-        name = f"tree_n{N}_m{M}"
-        out[name] = MethodSpec(name, "tree", int(M), int(N), int(M))
-    return out
 
 
 @dataclass(frozen=True)
@@ -252,34 +184,16 @@ class StepInfo:
     detected: bool = True  # whether the step measured (False only outside a footprint)
 
 
-def _hypotheses(
-    method: MethodSpec, x_hat: np.ndarray, P_hat: np.ndarray, setup: UAVSetup, rng
-) -> np.ndarray:
-    """The method's hypotheses at one planning step, unchecked (the arguments come from a
-    checked setup and method and the run's own tracker)."""
-    H = setup.planner.horizon
-    if method.family == "nbo":
-        return target.nominal(x_hat, H, setup.target, check=False)
-    if method.family == "rsmhp":
-        return target.sample_independent(
-            x_hat, P_hat, H, method.n_traj, setup.target, rng, check=False
-        )
-    if method.family == "tree":
-        states, _ = target.sample_tree(
-            x_hat, P_hat, H, method.n_branch, method.max_keep, setup.target, rng, check=False
-        )
-        return states
-    raise ValueError(f"unknown method family {method.family!r}")
-
-
 def simulate_run(
     setup: UAVSetup,
-    method: MethodSpec,
+    method: Method,
     seed: int,
     run: int,
     observer: Callable[[StepInfo], None] | None = None,
 ) -> tuple[dict[str, Any], list[dict[str, Any]]]:
-    """Simulate run ``run`` with ``method``: (summary row, per-step rows).
+    """Simulate run ``run`` with ``method`` (any registered :class:`rsmhp.uav.methods.Method`;
+    the loop only calls its :meth:`~rsmhp.uav.methods.Method.planner`): (summary row, per-step
+    rows).
 
     BLAS is limited to one thread for the run: the planner's small dense algebra (scipy's
     L-BFGS-B on 2H variables) is many times slower with a multi-threaded BLAS pool.
@@ -289,7 +203,7 @@ def simulate_run(
     and the tracker with ``check=False``.
     """
     guards.instance_of("setup", setup, UAVSetup)
-    guards.instance_of("method", method, MethodSpec)
+    guards.instance_of("method", method, Method)
     seed = guards.nonneg_int("seed", seed)
     run = guards.nonneg_int("run", run)
     if observer is not None and not callable(observer):
@@ -313,22 +227,11 @@ def _simulate_run(setup, method, seed, run, observer):
     warm = np.zeros((H, 2))
     rows: list[dict[str, Any]] = []
     plan_seconds = 0.0
+    planner = method.planner(setup)
     for k in range(1, K + 1):
-        x_hat, P_hat = trk.x, trk.P
         t0 = time.perf_counter()
-        rng = job_rng(seed, "uav_plan", run=run, step=k, **method.job_params())
-        hyp = _hypotheses(method, x_hat, P_hat, setup, rng)
-        problem = PlanningProblem(
-            uav_state,
-            P_hat,
-            hyp[..., :2],
-            setup.uav,
-            setup.target,
-            setup.sensor,
-            setup.planner,
-            check=False,
-        )
-        res = plan(problem, warm, check=False)
+        rng = job_rng(seed, "uav_plan", run=run, step=k, **method.job_key())
+        res = planner.plan(Belief(uav_state, trk.x, trk.P), warm, rng)
         plan_seconds += time.perf_counter() - t0
         warm = shift_plan(res.controls)
         uav_state = kinematics.step(uav_state, res.controls[0], setup.uav)
@@ -367,14 +270,13 @@ def _simulate_run(setup, method, seed, run, observer):
         if limited:  # variant-only column: the paper's model's outputs stay as they were
             rows[-1]["detected"] = bool(seen)
         if observer is not None:
+            hyp = res.hypotheses.states if res.hypotheses is not None else np.zeros((0, H, 4))
             observer(StepInfo(k, uav_state, x_true, x_est, P_est, res.uav_path, hyp, err, tr, warm))
     errors = np.array([r["error"] for r in rows])
     summary = {
         "method": method.name,
         "family": method.family,
-        "N_T": method.n_traj,
-        "N": method.n_branch if method.n_branch is not None else 0,
-        "M": method.max_keep if method.max_keep is not None else 0,
+        **method.columns(),
         "run": run,
         "seed": seed,
         "mean_error": float(errors.mean()),

@@ -15,7 +15,7 @@ state ``j + 1`` steps ahead. Three generators:
 * :func:`nominal` (NBO): one trajectory, :math:`x_j = F^j \hat x` (all noise at its mean 0).
 * :func:`sample_independent` (RS-MHP, non-overlapping): ``n`` trajectories,
   :math:`x_0^i \sim \mathcal N(\hat x, \hat P)`, :math:`x_j^i = F x_{j-1}^i + w_j^i`.
-* :func:`sample_tree` (RS-MHP, tree with pruning): level 0 draws ``N`` initial states, every
+* :func:`pruned_tree` (RS-MHP, tree with pruning): level 0 draws ``N`` initial states, every
   later level draws ``N`` process-noise values shared by all nodes of the level and branches
   every node ``N`` ways; after each level only the ``M`` trajectories of highest likeliness
   survive. Likeliness of a draw is its Gaussian density (of :math:`x_0` under
@@ -24,8 +24,8 @@ state ``j + 1`` steps ahead. Three generators:
   :mod:`rsmhp.sampling`, with the initial-state draw as an extra tree level.
 
   With shared draws the pruning depends only on the likeliness of the draws, never on the
-  states, so :func:`sample_tree` runs the expansion, pruning and propagation of the kept
-  nodes in one compiled routine (numba, on-disk cache); :func:`sample_tree_reference`, the
+  states, so :func:`pruned_tree` runs the expansion, pruning and propagation of the kept
+  nodes in one compiled routine (numba, on-disk cache); :func:`pruned_tree_reference`, the
   generic :func:`rsmhp.sampling.sample_tree`, is its test oracle (same random stream, same
   likeliness values bit for bit, same kept leaves in the same order, states equal up to the
   rounding of the 4 x 4 product).
@@ -42,17 +42,17 @@ import numpy as np
 from numba import njit
 
 from rsmhp import guards
-from rsmhp.sampling import GaussianNoise, top_m
-from rsmhp.sampling import sample_tree as _sample_tree
+from rsmhp.sampling import GaussianNoise, sample_tree, top_m
 
 __all__ = [
     "HypothesisNoise",
     "TargetModel",
+    "draw_independent",
     "nominal",
     "process_noise",
+    "pruned_tree",
+    "pruned_tree_reference",
     "sample_independent",
-    "sample_tree",
-    "sample_tree_reference",
     "transition_matrix",
 ]
 
@@ -196,14 +196,31 @@ def sample_independent(
     Stream order: ``n x 4`` standard normals for the initial states, then ``n x H x 4`` for the
     process noise. ``check=False`` skips the argument checks (see :func:`nominal`).
     """
+    return draw_independent(x_hat, P_hat, horizon, n, model, rng, check=check)[0]
+
+
+def draw_independent(
+    x_hat: np.ndarray,
+    P_hat: np.ndarray,
+    horizon: int,
+    n: int,
+    model: TargetModel,
+    rng: np.random.Generator,
+    *,
+    check: bool = True,
+) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`sample_independent` with its draws: ``(states (n, H, 4), noise (n, H + 1, 4))``,
+    ``noise[:, 0]`` the initial-state deviation :math:`x_0 - \\hat x`, ``noise[:, j]`` the
+    process noise :math:`w_j` (same stream, same states)."""
     if check:
         horizon = _check_estimate(x_hat, P_hat, horizon, model)
         n = guards.positive_int("n", n)
         guards.generator("rng", rng)
     z0 = rng.standard_normal((n, 4))
-    x0 = np.asarray(x_hat, dtype=float) + z0 @ _chol(P_hat).T
+    dev = z0 @ _chol(P_hat).T
+    x0 = np.asarray(x_hat, dtype=float) + dev
     w = rng.standard_normal((n, horizon, 4)) @ _chol(model.Q).T
-    return _propagate(x0, w, model.F)
+    return _propagate(x0, w, model.F), np.concatenate([dev[:, None, :], w], axis=1)
 
 
 @dataclass(frozen=True)
@@ -346,7 +363,7 @@ def _pruned_tree_kernel(x_hat, F, z, chols, log_norms, max_keep):  # pragma: no 
     return paths, ll
 
 
-def sample_tree(
+def pruned_tree(
     x_hat: np.ndarray,
     P_hat: np.ndarray,
     horizon: int,
@@ -364,7 +381,7 @@ def sample_tree(
     P)`, levels ``1..H`` draw ``N`` process-noise values :math:`w \sim \mathcal N(0, Q)`
     shared by all nodes; after every level the ``M`` most likely trajectories are kept.
     Survivors are returned sorted by decreasing likeliness (ties by tree order). Compiled;
-    equal to :func:`sample_tree_reference` (see the module docstring). ``check=False``
+    equal to :func:`pruned_tree_reference` (see the module docstring). ``check=False``
     skips the checks of ``x_hat``, ``P_hat`` (finite, positive definite), ``model`` and
     ``rng`` (see :func:`nominal`).
     """
@@ -384,7 +401,7 @@ def sample_tree(
     return paths[order, 1:], ll[order]
 
 
-def sample_tree_reference(
+def pruned_tree_reference(
     x_hat: np.ndarray,
     P_hat: np.ndarray,
     horizon: int,
@@ -393,12 +410,12 @@ def sample_tree_reference(
     model: TargetModel,
     rng: np.random.Generator,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """:func:`sample_tree` through the generic :func:`rsmhp.sampling.sample_tree` (the
+    """:func:`pruned_tree` through the generic :func:`rsmhp.sampling.sample_tree` (the
     plain reference implementation, used as the test oracle)."""
     horizon, n_branch, max_keep = _check_tree(x_hat, P_hat, horizon, n_branch, max_keep, model, rng)
     levels = _tree_levels(P_hat, horizon, n_branch, max_keep, model)
     system = _Hypotheses(F=model.F, noise=model.noise)
-    tree = _sample_tree(
+    tree = sample_tree(
         system,
         np.asarray(x_hat, dtype=float),
         np.arange(horizon + 1),
