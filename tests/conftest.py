@@ -7,15 +7,15 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rsmhp.experiments.lqg import LQGParams
+from rsmhp.lqg import LQGModel
 
 PAPER = {"x0": 0.0, "a": 0.5, "r": 10.0, "target": 1.0, "sigma": 1.0}
 PAPER_U = np.array([0.55, 0.17])
 
 
 @pytest.fixture
-def paper_params() -> LQGParams:
-    return LQGParams(**PAPER)
+def paper_params() -> LQGModel:
+    return LQGModel(**PAPER)
 
 
 @pytest.fixture

@@ -13,10 +13,12 @@ from scipy import stats as sps
 
 from rsmhp import lqg
 from rsmhp.analysis import lqg as analysis
+from rsmhp.claims import lqg as claims
 from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, run_convergence, run_nbo_error
 from rsmhp.figures import lqg as figs
 from rsmhp.io import IntermediateFileError, read_table, write_csv
 from rsmhp.ledger import Section
+from rsmhp.narrative import lqg as narrative
 from rsmhp.palette import method_colour
 from rsmhp.stats import binomial_ci, loglog_slope, mean_ci, rmse_ci
 
@@ -70,12 +72,12 @@ def test_fig3_and_prop3_verdicts_follow_the_data():
     var = lqg.cost_variance(PAPER_U, **PAPER)
     ps = [100, 400, 1600, 6400]
     good = synthetic({p: rng.normal(0, np.sqrt(var / p), 300) for p in ps})
-    c2, c3, _ = analysis.convergence_claims(analysis.summarize_convergence(good, [1.0]), [1.0])
+    c2, c3, _ = claims.convergence_claims(analysis.summarize_convergence(good, [1.0]), [1.0])
     assert c2.verdict == "supported" and c3.verdict == "supported"
     assert c2.key.null == 0.0 and c2.key.ci_high < 0
     # errors that do not shrink with P and are far larger than NBO's error and the bound
     bad = synthetic({p: rng.normal(0, 15.0, 300) for p in ps})
-    c2b, c3b, _ = analysis.convergence_claims(analysis.summarize_convergence(bad, [1.0]), [1.0])
+    c2b, c3b, _ = claims.convergence_claims(analysis.summarize_convergence(bad, [1.0]), [1.0])
     assert c2b.verdict == "not supported"
     assert c3b.verdict == "not supported" and c3b.key.value >= 1
 
@@ -89,14 +91,14 @@ def test_fig3_verdict_edge_cases():
     ps = [100, 400, 1600, 6400]
     # RMSE that does not fall with P (slope CI around 0), far below NBO's error: inconclusive
     flat = synthetic(dict(zip(ps, [_pm(1.0), _pm(1.2), _pm(0.9), _pm(1.1)], strict=True)))
-    c = analysis.fig3_claim(analysis.summarize_convergence(flat, [1.0]))
+    c = claims.fig3_claim(analysis.summarize_convergence(flat, [1.0]))
     assert c.key.ci_low < 0 < c.key.ci_high and c.verdict == "inconclusive"
     # RMSE falls like P^-1/2, but the mean keeps a bias of 0.5 at the largest P: inconclusive
     shrinking = {p: _pm(20 / np.sqrt(p)) for p in ps}
     biased = synthetic({p: e + 0.5 for p, e in shrinking.items()})
-    c = analysis.fig3_claim(analysis.summarize_convergence(biased, [1.0]))
+    c = claims.fig3_claim(analysis.summarize_convergence(biased, [1.0]))
     assert c.key.ci_high < 0 and c.verdict == "inconclusive"
-    c = analysis.fig3_claim(analysis.summarize_convergence(synthetic(shrinking), [1.0]))
+    c = claims.fig3_claim(analysis.summarize_convergence(synthetic(shrinking), [1.0]))
     assert c.verdict == "supported" and c.key.value == pytest.approx(-0.5)
 
 
@@ -105,7 +107,7 @@ def test_chebyshev_verdict_edge_cases():
     var = lqg.cost_variance(PAPER_U, **PAPER)
     # every bound Var(g)/(P eps^2) >= 1: no evidence, the cells are named as left out
     vac = synthetic({p: rng.normal(0, 1, 50) for p in (100, 200, 300)})
-    c = analysis.chebyshev_claim(analysis.summarize_convergence(vac, [0.25]), [0.25])
+    c = claims.chebyshev_claim(analysis.summarize_convergence(vac, [0.25]), [0.25])
     assert c.verdict == "inconclusive" and c.key.value == 0
     assert c.dropped.startswith("3 of 3 cells")
     # three informative cells; the first exceeds its bound per cell (95% Clopper-Pearson lower
@@ -118,13 +120,13 @@ def test_chebyshev_verdict_edge_cases():
         if binomial_ci(k, n)[0] > bound and binomial_ci(k, n, 1 - 0.05 / 3)[0] <= bound
     )
     errs = {ps[0]: np.r_[np.full(k, 1.5), np.zeros(n - k)], ps[1]: np.zeros(n), ps[2]: np.zeros(n)}
-    c = analysis.chebyshev_claim(analysis.summarize_convergence(synthetic(errs), [1.0]), [1.0])
+    c = claims.chebyshev_claim(analysis.summarize_convergence(synthetic(errs), [1.0]), [1.0])
     assert c.verdict == "supported" and c.key.value == 0 and not c.dropped
     assert "lower limits above the bound (no familywise correction): 1" in c.measured
     # one more exceedance than the familywise limit allows: not supported
     k2 = next(k2 for k2 in range(k, n) if binomial_ci(k2, n, 1 - 0.05 / 3)[0] > bound)
     errs[ps[0]] = np.r_[np.full(k2, 1.5), np.zeros(n - k2)]
-    c = analysis.chebyshev_claim(analysis.summarize_convergence(synthetic(errs), [1.0]), [1.0])
+    c = claims.chebyshev_claim(analysis.summarize_convergence(synthetic(errs), [1.0]), [1.0])
     assert c.verdict == "not supported" and c.key.value == 1
 
 
@@ -132,13 +134,13 @@ def test_weighted_verdict_detects_bias_and_agreement():
     err = {p: np.random.default_rng(p).normal(0, 0.1, 50) for p in (100, 200, 300)}
     lim_gap = lqg.weighted_limit(PAPER_U, **PAPER) - J
     biased = analysis.summarize_convergence(synthetic(err, weighted_offset=lim_gap), [1.0])
-    assert analysis.convergence_claims(biased, [1.0])[2].verdict == "not supported"
+    assert claims.convergence_claims(biased, [1.0])[2].verdict == "not supported"
     unbiased = analysis.summarize_convergence(synthetic(err), [1.0])
-    assert analysis.convergence_claims(unbiased, [1.0])[2].verdict == "supported"
+    assert claims.convergence_claims(unbiased, [1.0])[2].verdict == "supported"
     # a CI wide enough to hold both J and the derived limit J(sigma^2/2): inconclusive
     wide = {p: _pm(30.0, 50) for p in (100, 200, 300)}
     both = analysis.summarize_convergence(synthetic(wide, weighted_offset=lim_gap / 2), [1.0])
-    c = analysis.weighted_claim(both)
+    c = claims.weighted_claim(both)
     assert c.key.ci_low < J + lim_gap and c.key.ci_high > J
     assert c.verdict == "inconclusive"
 
@@ -168,10 +170,10 @@ def _nbo_grid(z: list[float]) -> pd.DataFrame:
 def test_nbo_error_claim_rejects_a_wrong_formula():
     conv = run_convergence(BASE, seed=2)
     nbo = analysis.summarize_nbo_error(run_nbo_error(BASE, seed=2))
-    assert analysis.nbo_error_claim(nbo, conv).verdict in ("supported", "not supported")
+    assert claims.nbo_error_claim(nbo, conv).verdict in ("supported", "not supported")
     wrong = nbo.assign(nbo_error_closed=nbo["nbo_error_closed"] * 1.5)
     wrong = wrong.assign(z=(wrong["nbo_error_sim"] - wrong["nbo_error_closed"]) / wrong["se"])
-    assert analysis.nbo_error_claim(wrong, conv).verdict == "not supported"
+    assert claims.nbo_error_claim(wrong, conv).verdict == "not supported"
 
 
 def test_nbo_error_verdict_at_the_bonferroni_limit():
@@ -180,10 +182,10 @@ def test_nbo_error_verdict_at_the_bonferroni_limit():
     assert analysis.paper_setting_nbo_error(conv).z == pytest.approx(0.0, abs=1e-9)
     limit = analysis.nbo_z_limit(4)  # 4 grid cells + the paper's setting = 5 tests
     assert limit == pytest.approx(sps.norm.ppf(1 - 0.025 / 5))
-    at = analysis.nbo_error_claim(_nbo_grid([0.1, -limit, 0.5, 1.0]), conv)
+    at = claims.nbo_error_claim(_nbo_grid([0.1, -limit, 0.5, 1.0]), conv)
     assert at.verdict == "supported" and at.key.value == pytest.approx(limit)
     assert "over 5 tests" in at.key.name and at.key.reproducible == "bitwise"
-    above = analysis.nbo_error_claim(_nbo_grid([0.1, -limit - 0.01, 0.5, 1.0]), conv)
+    above = claims.nbo_error_claim(_nbo_grid([0.1, -limit - 0.01, 0.5, 1.0]), conv)
     assert above.verdict == "not supported"
 
 
@@ -223,8 +225,8 @@ def small():
     conv = run_convergence(BASE, seed=2)
     nbo = analysis.summarize_nbo_error(run_nbo_error(BASE, seed=2))
     summary = analysis.summarize_convergence(conv, EPS)
-    tables = analysis.lqg_tables(summary, nbo, EPS)
-    section = analysis.lqg_section(summary, nbo, conv, EPS, tables)
+    tables = narrative.lqg_tables(summary, nbo, EPS)
+    section = narrative.lqg_section(summary, nbo, conv, EPS, tables)
     return {"conv": conv, "nbo": nbo, "summary": summary, "tables": tables, "section": section}
 
 
@@ -251,12 +253,12 @@ def test_section_budget_numbers_and_roundtrip(small, tmp_path):
     assert set(_column(conv_table, "replicates")) == {"4"}
     cheb = small["tables"]["lqg_chebyshev"]
     assert all(re.fullmatch(r"\d+", v) for v in _column(cheb, "exceedances"))
-    for name in analysis.FIGURES:
+    for name in narrative.FIGURES:
         assert f"(figures/{name}.png)" in section.body
-    assert section.figures == [f"{f}.png" for f in analysis.FIGURES]
+    assert section.figures == [f"{f}.png" for f in narrative.FIGURES]
     for key in ("x_k", "u_k", "w_k", "σ", "weight r", "target T", "horizon H", "J_NBO", "Var(g)"):
         assert key in section.body
-    for stem in analysis.TABLES:
+    for stem in narrative.TABLES:
         assert small["tables"][stem] in section.appendix
     section.save(tmp_path / "lqg.json")
     assert Section.load(tmp_path / "lqg.json") == section
@@ -311,3 +313,70 @@ def test_nbo_residual_panel_clips_and_says_so(small):
     texts = [t.get_text() for t in resid.texts]
     assert any("1 residuals beyond ±8 drawn at the edge" in t for t in texts)
     plt.close(fig)
+
+
+# ------------------------------------------------ verdict rules (rsmhp.claims.lqg) at their edges
+
+FIG3_OK = {
+    "slope_low": -0.6,
+    "slope_high": -0.4,
+    "mean_low": 18.0,
+    "mean_high": 19.0,
+    "J": 18.5,
+    "rmse_low": 0.1,
+    "rmse_high": 0.2,
+    "nbo_error": 12.5,
+}
+
+
+@pytest.mark.parametrize(
+    ("change", "verdict"),
+    [
+        ({}, "supported"),
+        ({"J": 19.0}, "supported"),  # J on the CI's edge is inside it
+        ({"slope_high": 0.0}, "inconclusive"),  # a CI touching 0 does not lie below it
+        ({"slope_low": 0.0, "slope_high": 0.1}, "not supported"),  # at/above 0
+        ({"rmse_high": 12.5}, "inconclusive"),  # upper limit not below NBO's error
+        ({"rmse_low": 12.5, "rmse_high": 13.0}, "not supported"),  # lower limit reaches it
+        ({"J": 19.01}, "inconclusive"),  # mean biased, RMSE and slope fine
+    ],
+)
+def test_fig3_rule_edges(change, verdict):
+    assert claims.FIG3_RULE.verdict({**FIG3_OK, **change}) == verdict
+
+
+@pytest.mark.parametrize(
+    ("informative", "count", "verdict"),
+    [(0, 0, "inconclusive"), (3, 0, "supported"), (3, 1, "not supported")],
+)
+def test_chebyshev_rule_edges(informative, count, verdict):
+    assert claims.CHEBYSHEV_RULE.verdict({"informative cells": informative, "count": count}) == (
+        verdict
+    )
+
+
+@pytest.mark.parametrize(
+    ("J", "limit", "verdict"),
+    [
+        (2.0, 0.0, "supported"),  # J on the CI's upper edge (inside), the limit outside
+        (2.0, 1.0, "inconclusive"),  # the limit on the lower edge counts as inside
+        (2.0001, 0.0, "not supported"),
+    ],
+)
+def test_weighted_rule_edges(J, limit, verdict):
+    facts = {"ci_low": 1.0, "ci_high": 2.0, "J": J, "limit": limit}
+    assert claims.WEIGHTED_RULE.verdict(facts) == verdict
+
+
+def test_claims_print_the_rule_they_apply(small):
+    section = small["section"]
+    by_id = {c.id: c for c in section.claims}
+    n_tests = len(small["nbo"]) + 1
+    rule = claims.nbo_error_rule(analysis.nbo_z_limit(len(small["nbo"])), n_tests)
+    assert by_id["LQG-1"].rule == rule.text()
+    assert f"Bonferroni over {n_tests} tests" in rule.text()
+    assert by_id["LQG-2"].rule == claims.FIG3_RULE.text()
+    assert by_id["LQG-3"].rule == claims.CHEBYSHEV_RULE.text()
+    assert by_id["LQG-4"].rule == claims.WEIGHTED_RULE.text()
+    for c in section.claims:
+        assert c.rule.endswith("otherwise")

@@ -295,3 +295,161 @@ def test_rule_scripts_report_expected_failures_without_a_traceback(tmp_path):
         with rule_logging(log, "demo"):
             1 / 0  # noqa: B018
     assert "Traceback" in log.read_text()
+
+
+# ------------------------------------------------------------------------- code versions
+
+
+def _stamped_csv(path: Path, stamp: str | None) -> str:
+    from rsmhp.io import stamping, write_csv
+
+    with stamping(stamp):
+        write_csv(_frame(), path)
+    return str(path)
+
+
+def test_inputs_of_one_code_version_pass(tmp_path):
+    from rsmhp.contracts import check_codes
+
+    files = [_stamped_csv(tmp_path / f"{k}.csv", "make_t:aaaaaaaaaaaa") for k in range(3)]
+    other = _stamped_csv(tmp_path / "o.csv", "make_u:bbbbbbbbbbbb")
+    plain = _stamped_csv(tmp_path / "p.csv", None)  # written outside a rule: not checked
+    got = check_codes([*files, other, plain, tmp_path / "fig.png"], {"make_t": "aaaaaaaaaaaa"}.get)
+    assert got == {**dict.fromkeys(files, "make_t:aaaaaaaaaaaa"), other: "make_u:bbbbbbbbbbbb"}
+
+
+def test_inputs_of_two_code_versions_of_one_rule_are_refused(tmp_path):
+    from rsmhp.contracts import check_codes
+
+    old = _stamped_csv(tmp_path / "old.csv", "make_t:aaaaaaaaaaaa")
+    new = [_stamped_csv(tmp_path / f"n{k}.csv", "make_t:bbbbbbbbbbbb") for k in range(4)]
+    with pytest.raises(IntermediateFileError) as err:
+        check_codes([old, *new], {"make_t": "bbbbbbbbbbbb"}.get)
+    msg = str(err.value)
+    assert msg.startswith(f"{old} by code aaaaaaaaaaaa; {new[0]}, {new[1]}, {new[2]} and 1 more")
+    assert "different versions of the code of rule make_t (the current code gives bbbb" in msg
+    assert "nothing was computed" in msg and "`snakemake -j2 --forcerun make_t`" in msg
+    with pytest.raises(IntermediateFileError, match="different versions"):
+        check_codes([old, new[0]])  # mixed is refused even when the current code is unknown
+
+
+def test_inputs_of_outdated_code_are_refused(tmp_path):
+    from rsmhp.contracts import check_codes
+
+    files = [_stamped_csv(tmp_path / f"{k}.csv", "make_t:aaaaaaaaaaaa") for k in range(2)]
+    with pytest.raises(IntermediateFileError) as err:
+        check_codes(files, {"make_t": "cccccccccccc"}.get)
+    assert str(err.value) == (
+        f"{files[0]}, {files[1]}: made by code aaaaaaaaaaaa of rule make_t, but its code now "
+        "gives cccccccccccc (an rsmhp module it imports changed since); nothing was computed: "
+        "rerun rule make_t (e.g. `snakemake -j2 --forcerun make_t`)"
+    )
+
+
+def _job(tmp_path: Path, rule: str, code: str | None, inputs: list[str]):
+    """What a rule script gets as ``snakemake`` (the fields rule_logging uses)."""
+    from types import SimpleNamespace
+
+    scripts = tmp_path / "workflow" / "scripts"
+    scripts.mkdir(parents=True, exist_ok=True)
+    (tmp_path / "src" / "rsmhp").mkdir(parents=True, exist_ok=True)
+    (tmp_path / "src" / "rsmhp" / "__init__.py").touch()
+    params = SimpleNamespace(**({"code": code} if code is not None else {}))
+    return SimpleNamespace(
+        log=[str(tmp_path / "logs" / f"{rule}.log")],
+        rule=rule,
+        params=params,
+        input=inputs,
+        scriptdir=str(scripts),
+    )
+
+
+def test_rule_logging_stamps_outputs_and_refuses_mixed_inputs_before_the_block(tmp_path):
+    from rsmhp.code_digest import code_digest
+    from rsmhp.io import recorded_code, write_csv
+    from rsmhp.pipeline import rule_logging
+
+    job = _job(tmp_path, "make_t", "aaaaaaaaaaaa", [])
+    with rule_logging(job):
+        write_csv(_frame(), tmp_path / "t.csv")
+    assert recorded_code(tmp_path / "t.csv") == "make_t:aaaaaaaaaaaa"
+    # the producer's current code comes from workflow/scripts/<rule>.py and the workflow's src
+    script = tmp_path / "workflow/scripts/make_t.py"
+    script.write_text("import rsmhp\n")
+    now = code_digest(script, tmp_path / "src")
+    good = _stamped_csv(tmp_path / "good.csv", f"make_t:{now}")
+    with rule_logging(_job(tmp_path, "use_t", "dddddddddddd", [good])):
+        pass
+    log = (tmp_path / "logs/use_t.log").read_text()
+    assert f"inputs made by: make_t:{now}" in log and "code dddddddddddd" in log
+    ran = []
+    with pytest.raises(SystemExit) as exit_:
+        with rule_logging(_job(tmp_path, "use_t", "dddddddddddd", [good, str(tmp_path / "t.csv")])):
+            ran.append(True)
+    assert exit_.value.code == 1 and not ran  # refused before the block ran
+    log = (tmp_path / "logs/use_t.log").read_text()
+    assert "failed: " in log and "rerun rule make_t" in log and "Traceback" not in log
+
+
+def test_rule_logging_refuses_a_job_whose_code_changed_after_parsing(tmp_path, monkeypatch):
+    """Snakemake runs a script with __file__ set to its path: the job compares the digest of
+    its code now with the `code` param computed when the workflow was parsed."""
+    import sys
+    from types import ModuleType
+
+    from rsmhp.code_digest import code_digest
+    from rsmhp.pipeline import rule_logging
+
+    job = _job(tmp_path, "make_t", None, [])
+    script = Path(job.scriptdir) / "make_t.py"
+    script.write_text("import rsmhp\n")
+    main = ModuleType("__main__")
+    main.__file__ = str(script)
+    monkeypatch.setitem(sys.modules, "__main__", main)
+    job.params.code = code_digest(script, tmp_path / "src")
+    with rule_logging(job):
+        pass
+    (tmp_path / "src/rsmhp/__init__.py").write_text("CHANGED = True\n")
+    with pytest.raises(SystemExit):
+        with rule_logging(job):
+            pass
+    log = (tmp_path / "logs/make_t.log").read_text()
+    assert "the code of rule make_t changed after the workflow was parsed" in log
+
+
+@pytest.mark.workflow
+def test_the_workflow_refuses_chunks_of_mixed_or_outdated_code(run_j2, tmp_path):
+    """Issue 18: chunks made by two versions of the simulation code (a partial rerun after an
+    edit), or all by a version that is not the current one, stop uav_collect before it
+    computes anything, naming the files, their digests and the rule to rerun; the chunks are
+    left as they were."""
+    wd = tmp_path / "wd"
+    shutil.copytree(run_j2, wd, symlinks=True)
+    chunks = sorted((wd / "results/uav/chunks").glob("*/*.*"))
+    assert len(chunks) >= 4
+    good = pd.read_csv(chunks[0])["code"].iloc[0]
+    assert good.startswith("uav_simulate:")
+
+    def restamp(path: Path, digest: str) -> None:
+        df = _read(path)
+        _save(df.assign(code=f"uav_simulate:{digest}"), path)
+
+    nbo = wd / "results/uav/chunks/nbo/0.csv"
+    restamp(nbo, "000000000000")  # one chunk from older code
+    before = {p: p.read_bytes() for p in chunks}
+    res = snakemake(wd, "-j1", "uav_collect")
+    out = res.stdout + res.stderr
+    assert res.returncode != 0, out[-2000:]
+    assert "Error in rule uav_collect" in out and "Traceback" not in out
+    assert "failed: results/uav/chunks/nbo/0.csv by code 000000000000; " in out
+    assert f"by code {good.split(':')[1]}: inputs made by different versions of the code" in out
+    assert "of rule uav_simulate" in out and "`snakemake -j2 --forcerun uav_simulate`" in out
+    assert {p: p.read_bytes() for p in chunks} == before  # nothing overwritten
+    assert not (wd / "results/uav/runs.csv").exists()  # and nothing aggregated
+    for path in chunks:  # every chunk from the same, outdated code
+        restamp(path, "000000000000")
+    res = snakemake(wd, "-j1", "uav_collect")
+    out = res.stdout + res.stderr
+    assert res.returncode != 0 and "Traceback" not in out
+    assert "made by code 000000000000 of rule uav_simulate, but its code now gives" in out
+    assert "rerun rule uav_simulate" in out

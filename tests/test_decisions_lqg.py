@@ -15,8 +15,9 @@ from matplotlib.colors import to_hex
 from scipy import stats
 from scipy.optimize import minimize
 
-from rsmhp import lqg, samplers
-from rsmhp.analysis import decisions as dec
+from rsmhp import designs, lqg
+from rsmhp.analysis import decisions_lqg as dec
+from rsmhp.claims import decisions_lqg as dec_claims
 from rsmhp.experiments.decisions_lqg import (
     RegretCell,
     regret_cells,
@@ -24,6 +25,7 @@ from rsmhp.experiments.decisions_lqg import (
     sobol_budget,
 )
 from rsmhp.figures import decisions as figs
+from rsmhp.narrative import decisions_lqg as dec_text
 from rsmhp.palette import method_colour
 from rsmhp.sampling import rollout_cost, sample_tree
 
@@ -97,7 +99,7 @@ def test_sample_argmin_minimises_the_library_sample_cost(p, n, weighted, seed):
         assert abs(grad_k) <= 1e-7 * scale / 1e-3
     for _ in range(5):
         assert j_hat(u_hat + rng.normal(0.0, 0.05, H)) >= j_hat(u_hat) - 1e-12 * scale
-    c = (1.0 - p["a"]) ** np.arange(H - 1, -1, -1)
+    c = lqg.coefficients(H, p["a"])
     e_bar = float(omega @ (noise[:, :, 0] @ c) / omega.sum())
     expected = lqg.regret_gain(H, a=p["a"], r=p["r"]) * e_bar**2
     assert lqg.regret(u_hat, **kw) == pytest.approx(expected, rel=1e-8, abs=1e-14)
@@ -110,8 +112,8 @@ def test_nbo_antithetic_and_cubature_have_zero_regret():
     chol = np.array([[1.0]])
     j_star = lqg.exact_cost(lqg.optimal_controls(H, **kw), **kw, sigma=1.0)
     nbo = lqg.sample_argmin(np.zeros((1, H)), np.ones(1), **kw)
-    anti, wa = samplers.antithetic(rng, 100, H, chol)
-    cub, wc = samplers.cubature(H, chol)
+    anti, wa = designs.antithetic(rng, 100, H, chol)
+    cub, wc = designs.cubature(H, chol)
     for noise, w in ((np.zeros((1, H)), np.ones(1)), (anti, wa), (cub, wc)):
         assert lqg.regret(lqg.sample_argmin(noise, w, **kw), **kw) <= 1e-24 * j_star
     np.testing.assert_allclose(nbo, lqg.optimal_controls(H, **kw), rtol=1e-14)
@@ -150,7 +152,7 @@ def test_mc_regret_is_scaled_chi_square(P):
     chol = np.array([[0.8]])
     reg = np.array(
         [
-            lqg.regret(lqg.sample_argmin(*samplers.monte_carlo(rng, P, H, chol), **kw), **kw)
+            lqg.regret(lqg.sample_argmin(*designs.monte_carlo(rng, P, H, chol), **kw), **kw)
             for _ in range(R)
         ]
     )
@@ -163,7 +165,7 @@ def test_shared_draw_tree_regret_is_that_of_n_trajectories():
     a, H, N, R = 0.5, 3, 4, 2000
     kw = {"x0": 0.0, "a": a, "r": 10.0, "target": 1.0}
     model = lqg.LQGModel(a=a, r=10.0, target=1.0, sigma=1.0)
-    c = (1.0 - a) ** np.arange(H - 1, -1, -1)
+    c = lqg.coefficients(H, a)
     rng = np.random.default_rng(7)
     reg = np.empty(R)
     for i in range(R):
@@ -326,7 +328,7 @@ def _synthetic(nbo_regret: float, pruned_slope: float, seed: int = 3) -> pd.Data
 def _verdicts(df: pd.DataFrame) -> dict[str, str]:
     summary = dec.summarize_lqg_regret(df, MODEL)
     scaling = dec.lqg_scaling(summary)
-    return {c.id: c.verdict for c in dec.lqg_claims(summary, scaling, MODEL)}
+    return {c.id: c.verdict for c in dec_claims.lqg_claims(summary, scaling, MODEL)}
 
 
 def test_claims_follow_their_rules():
@@ -390,7 +392,7 @@ def _scaling(method: str, fits: list[tuple[float, float, float]]) -> pd.DataFram
 
 
 def _claim(summary: pd.DataFrame, scaling: pd.DataFrame, cid: str):
-    return {c.id: c for c in dec.lqg_claims(summary, scaling, MODEL)}[cid]
+    return {c.id: c for c in dec_claims.lqg_claims(summary, scaling, MODEL)}[cid]
 
 
 @pytest.mark.parametrize(
@@ -494,7 +496,7 @@ def _pruned_summary() -> pd.DataFrame:
 def test_dec4_rule_edges(fits, verdict):
     c = _claim(_pruned_summary(), _scaling("pruned", fits), "DEC-4")
     assert c.verdict == verdict
-    assert f"above −{-dec.PRUNED_FLAT:g}" in c.rule  # the rule states the constant it uses
+    assert f"above −{-dec_claims.PRUNED_FLAT:g}" in c.rule  # the rule states the constant it uses
     steep = min(fits, key=lambda f: f[1])
     assert (c.key.value, c.key.ci_low, c.key.ci_high) == steep
     # the (a, H) cells without a slope are named as left out
@@ -543,15 +545,15 @@ def _section():
     df = _synthetic(nbo_regret=0.0, pruned_slope=0.0)
     summary = dec.summarize_lqg_regret(df, MODEL)
     scaling = dec.lqg_scaling(summary)
-    tables = dec.lqg_tables(summary, scaling)
-    return summary, tables, dec.lqg_decision_section(summary, scaling, tables, MODEL, CFG)
+    tables = dec_text.lqg_tables(summary, scaling)
+    return summary, tables, dec_text.lqg_decision_section(summary, scaling, tables, MODEL, CFG)
 
 
 def test_section_budget_and_text():
     _, tables, section = _section()
     assert len(section.body.encode("utf-8")) <= 2600
     assert [c.id for c in section.claims] == ["DEC-1", "DEC-2", "DEC-3", "DEC-4"]
-    assert section.figures == list(dec.LQG_FIGURES)
+    assert section.figures == list(dec_text.FIGURES)
     for name in section.figures:
         assert f"](figures/{name}.png)" in section.body
     assert "### Claims" not in section.body
@@ -573,12 +575,12 @@ def test_claims_fit_the_ledger():
     _, _, section = _section()
     for c in section.claims:
         assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300
-        assert c.rule == dec.LQG_RULES[c.id]
+        assert c.rule == dec_claims.RULES[c.id].text()
         assert c.key.reproducible == "bitwise"
         for text in (c.claim, c.paper, c.key.text(), c.measured, c.dropped):
             assert not NAN_INF.search(text)
-    for rule in dec.LQG_RULES.values():
-        assert len(rule) <= 300
+    for rule in dec_claims.RULES.values():
+        assert len(rule.text()) <= 300
 
 
 def test_figure_colours_are_the_palette():
@@ -617,3 +619,50 @@ def test_summary_z_scores_and_j_star():
     assert summary.loc[(summary.a == 0.4) & (summary.H == 2), "J_star"].iloc[0] == pytest.approx(
         j_star
     )
+
+
+# -------------------------------------------------- verdict rules (RULES) at their exact limits
+
+
+def test_dec_rules_at_their_limits():
+    rules = dec_claims.RULES
+    assert rules["DEC-1"].verdict({"max NBO regret / J(u*)": dec_claims.NBO_ROUNDING}) == (
+        "not supported"
+    )
+    assert rules["DEC-1"].verdict({"max NBO regret / J(u*)": dec_claims.NBO_SEVERE}) == "supported"
+    z = {"max |z|": 2.5, "z limit": 2.5}  # at the limit: within it
+    assert rules["DEC-3"].verdict(z) == "supported"
+    assert rules["DEC-3"].verdict({**z, "max |z|": float("nan")}) == "not supported"  # no cell
+    fits = {"highest upper limit": -0.5, "highest lower limit": -1.0, "lowest upper limit": -1.0}
+    assert rules["DEC-2"].verdict({**fits, **z}) == "supported"  # CIs reaching -1 contain it
+    assert rules["DEC-2"].verdict({**fits, **z, "highest upper limit": 0.0}) == "not supported"
+    assert rules["DEC-2"].verdict({**fits, **z, "highest lower limit": -0.99}) == "inconclusive"
+    flat = {"cells": 2, "cells falling": 0, "lowest lower limit": dec_claims.PRUNED_FLAT}
+    assert rules["DEC-4"].verdict(flat) == "inconclusive"  # a CI reaching -0.1 admits a fall
+    assert rules["DEC-4"].verdict({**flat, "lowest lower limit": -0.09}) == "not supported"
+    assert rules["DEC-4"].verdict({**flat, "cells falling": 2}) == "supported"
+    assert rules["DEC-5"].verdict({**z, "largest ratio": 0.999}) == "supported"
+    assert rules["DEC-5"].verdict({**z, "largest ratio": 1.0}) == "not supported"
+    # the printed rules state the constants they use
+    assert "1e-9 × J(u*)" in rules["DEC-1"].text() and "1% of J(u*)" in rules["DEC-1"].text()
+    assert "lowers regret by < 21%" in rules["DEC-4"].text()
+    assert f"P ≥ {dec.WEIGHTED_MIN_P}" in rules["DEC-5"].text()
+
+
+def test_weighted_mc_regret_matches_the_first_order_closed_form():
+    """Likeliness-weighted argmin over P i.i.d. trajectories: mean regret
+    kappa v_H (4/3)^{H/2} / (3P) to first order in 1/P (rsmhp.lqg.weighted_expected_regret)."""
+    a, H, P, R, sigma = 0.5, 2, 400, 2000, 1.0
+    kw = {"x0": 0.0, "a": a, "r": 10.0, "target": 1.0}
+    rng = np.random.default_rng(11)
+    reg = np.empty(R)
+    for i in range(R):
+        noise = rng.normal(0.0, sigma, (P, H))
+        logw = -0.5 * (noise**2).sum(axis=1) / sigma**2
+        reg[i] = lqg.regret(lqg.sample_argmin(noise, np.exp(logw - logw.max()), **kw), **kw)
+    mean = lqg.weighted_expected_regret(P, H, a=a, r=10.0, sigma=sigma)
+    assert mean == pytest.approx(
+        lqg.expected_regret(P, H, a=a, r=10.0, sigma=sigma) * lqg.weighted_regret_ratio(H)
+    )
+    # the regret's spread is not exactly chi2_1 here; its sample SD gives the standard error
+    assert abs(reg.mean() - mean) < 4 * reg.std(ddof=1) / np.sqrt(R)

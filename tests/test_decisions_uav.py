@@ -15,7 +15,8 @@ import pytest
 import yaml
 from matplotlib.colors import to_hex
 
-from rsmhp.analysis import decisions as dec
+from rsmhp.analysis import decisions_uav as dec
+from rsmhp.claims import decisions_uav as dec_claims
 from rsmhp.experiments.decisions_uav import (
     MAP_RUN_COLUMNS,
     REGRET_COLUMNS,
@@ -26,6 +27,7 @@ from rsmhp.experiments.decisions_uav import (
     score_state,
 )
 from rsmhp.figures import decisions as figs
+from rsmhp.narrative import decisions_uav as dec_text
 from rsmhp.palette import method_colour
 from rsmhp.uav import methods as uav_methods
 from rsmhp.uav.simulation import UAVSetup, draw_scenario, simulate_run
@@ -161,7 +163,7 @@ EMPTY_SUMMARY = pd.DataFrame(columns=dec.UAV_SUMMARY_COLUMNS).astype({"method": 
 def _map_claims(runs: pd.DataFrame) -> dict:
     m = dec.summarize_map(runs, pd.DataFrame(columns=REGRET_COLUMNS), MAP_CFG, 1, 500)
     groups = dec.summarize_map_groups(runs, m, 1, 500)
-    claims = dec.uav_claims(EMPTY_REGRET, EMPTY_SUMMARY, m, groups, 1, 500)
+    claims = dec_claims.uav_claims(EMPTY_REGRET, EMPTY_SUMMARY, m, groups, 1, 500)
     return m, groups, {c.id: c for c in claims}
 
 
@@ -195,7 +197,7 @@ def test_map_group_needs_every_cell():
     assert g["n_cells"] == 2 and g["n_below"] == 1 and g["ci_high"] < 0
     assert claims["DEC-8a"].verdict == "inconclusive"
     # the group mean is the mean over cells of the per-run differences
-    d = [dec._paired_errors(runs, c, "rsmhp_nt100") for c in ("r1c0", "r0c0x")]
+    d = [dec.paired_errors(runs, c, "rsmhp_nt100") for c in ("r1c0", "r0c0x")]
     assert g["mean_diff"] == pytest.approx(float(pd.concat(d, axis=1).mean(axis=1).mean()))
 
 
@@ -251,7 +253,7 @@ def _regret_claims(spec: dict) -> dict:
     df = _regret_rows(spec)
     summary = dec.summarize_uav_regret(df, 1, 500)
     empty = pd.DataFrame(columns=dec.MAP_GROUP_COLUMNS)
-    claims = dec.uav_claims(df, summary, pd.DataFrame(), empty, 1, 500)
+    claims = dec_claims.uav_claims(df, summary, pd.DataFrame(), empty, 1, 500)
     return {c.id: c for c in claims}
 
 
@@ -289,10 +291,11 @@ def test_regret_summary_and_claims():
 def test_dec6_equivalence_rule(nbo, rs, sd, verdict):
     c = _regret_claims({"paper": (nbo, rs, sd)})["DEC-6"]
     assert c.verdict == verdict
-    margin = 100 * dec.EQUIVALENCE_MARGIN
+    margin = 100 * dec_claims.EQUIVALENCE_MARGIN
     inside = -margin < c.key.ci_low and c.key.ci_high < margin
     assert inside == (verdict == "supported")
-    assert f"±{100 * dec.EQUIVALENCE_MARGIN:g} percentage points" in c.rule  # rule = constant
+    assert f"±{margin:g} percentage points" in c.rule  # the rule prints the constant
+    assert c.rule == dec_claims.DEC6_RULE.text()
 
 
 @pytest.mark.parametrize(
@@ -335,8 +338,8 @@ def _section():
     runs = _map_runs(-2.0)
     m = dec.summarize_map(runs, pd.DataFrame(columns=REGRET_COLUMNS), MAP_CFG, 1, 500)
     groups = dec.summarize_map_groups(runs, m, 1, 500)
-    tables = dec.uav_tables(summary, m)
-    section = dec.uav_decision_section(regret, summary, m, groups, tables, SECTION_CFG, 1)
+    tables = dec_text.uav_tables(summary, m)
+    section = dec_text.uav_decision_section(regret, summary, m, groups, tables, SECTION_CFG, 1)
     return regret, m, tables, section
 
 
@@ -344,7 +347,7 @@ def test_section_budget_and_text():
     _, _, tables, section = _section()
     assert len(section.body.encode("utf-8")) <= 2600
     assert [c.id for c in section.claims] == ["DEC-6", "DEC-7-fp150", "DEC-8a", "DEC-8b"]
-    for name in dec.UAV_FIGURES:
+    for name in dec_text.FIGURES:
         assert f"](figures/{name}.png)" in section.body
     assert not re.search(r"^\|", section.body, re.MULTILINE)  # tables go to the appendix
     for word in ("Relative regret", "percentage points", "N_T", "footprint", "track loss"):
@@ -365,10 +368,15 @@ def test_section_budget_and_text():
 
 def test_claims_fit_the_ledger():
     _, _, _, section = _section()
-    rules = {"DEC-6": "DEC-6", "DEC-7-fp150": "DEC-7", "DEC-8a": "DEC-8", "DEC-8b": "DEC-8"}
+    rules = {
+        "DEC-6": dec_claims.DEC6_RULE,
+        "DEC-7-fp150": dec_claims.DEC7_RULE,
+        "DEC-8a": dec_claims.DEC8_RULE,
+        "DEC-8b": dec_claims.DEC8_RULE,
+    }
     for c in section.claims:
         assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300, c.id
-        assert c.rule == dec.UAV_RULES[rules[c.id]]
+        assert c.rule == rules[c.id].text()
         assert c.key.reproducible == "statistical" and c.key.has_ci
         for text in (c.claim, c.paper, c.key.text(), c.measured, c.dropped):
             assert not NAN_INF.search(text)
@@ -418,6 +426,55 @@ def test_limited_cells_follow_the_axis_else_the_base_sensor():
             "col_value": [1.0, 1.0, 10.0, 50.0],
         }
     )
-    assert dec._limited(m).tolist() == [False, True, False, False]
+    assert dec.limited_cells(m).tolist() == [False, True, False, False]
     # a base footprint applies where no axis sets the radius; a null axis value overrides it
-    assert dec._limited(m, base_limited=True).tolist() == [False, True, True, True]
+    assert dec.limited_cells(m, base_limited=True).tolist() == [False, True, True, True]
+
+
+@pytest.mark.parametrize(
+    "lo, hi, verdict",
+    [
+        (-0.49, 0.49, "supported"),  # inside ±0.5 pp
+        (-0.5, 0.2, "inconclusive"),  # touches the margin: not inside
+        (0.2, 0.5, "inconclusive"),
+        (0.4, 0.6, "inconclusive"),  # straddles it
+        (-0.6, 0.6, "inconclusive"),  # wider than the margin on both sides
+        (0.5, 0.9, "not supported"),  # entirely at or beyond +0.5 pp
+        (-0.9, -0.5, "not supported"),
+    ],
+)
+def test_dec6_rule_boundaries(lo, hi, verdict):
+    facts = {f"{dec_claims.KEY}_low": lo, f"{dec_claims.KEY}_high": hi}
+    assert dec_claims.DEC6_RULE.verdict(facts) == verdict
+
+
+@pytest.mark.parametrize(
+    "lo, hi, verdict",
+    [
+        (1e-12, 1.0, "supported"),
+        (0.0, 1.0, "inconclusive"),  # touches 0
+        (-1.0, 0.0, "inconclusive"),
+        (-1.0, -1e-12, "not supported"),
+    ],
+)
+def test_dec7_rule_boundaries(lo, hi, verdict):
+    facts = {f"{dec_claims.KEY}_low": lo, f"{dec_claims.KEY}_high": hi}
+    assert dec_claims.DEC7_RULE.verdict(facts) == verdict
+
+
+@pytest.mark.parametrize(
+    "below, above, lo, hi, verdict",
+    [
+        (2, 0, -1.0, -1e-12, "supported"),  # every cell and the pooled mean below 0
+        (2, 0, -1.0, 0.0, "inconclusive"),  # the pooled CI touches 0
+        (1, 0, -1.0, -0.5, "inconclusive"),  # one cell undecided
+        (1, 1, -1.0, -0.5, "not supported"),  # one cell above 0
+        (0, 0, 1e-12, 1.0, "not supported"),  # the pooled mean above 0
+        (0, 0, 0.0, 1.0, "inconclusive"),
+    ],
+)
+def test_dec8_rule_boundaries(below, above, lo, hi, verdict):
+    group = pd.Series(
+        {"n_cells": 2, "n_below": below, "n_above": above, "ci_low": lo, "ci_high": hi}
+    )
+    assert dec_claims.DEC8_RULE.verdict(dec_claims.map_facts(group)) == verdict

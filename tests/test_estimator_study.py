@@ -1,4 +1,5 @@
-"""The estimator ablation driver and its analysis: grid, reproducibility, oracles, verdicts."""
+"""The estimator ablation driver, its statistics, claims and report section: grid,
+reproducibility, oracles, verdict rules (with their boundaries)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import pandas as pd
 import pytest
 
 from rsmhp.analysis import estimators as analysis
+from rsmhp.claims import estimators as est_claims
 from rsmhp.experiments.estimators import (
     ABLATION_COLUMNS,
     GridPoint,
@@ -16,6 +18,7 @@ from rsmhp.experiments.estimators import (
     grid_points,
     run_ablation,
 )
+from rsmhp.narrative import estimators as narrative
 
 MODEL = {"a": 0.5, "x0": 0.0, "r": 10.0, "target": 1.0, "sigma": 1.0}
 NCV = {
@@ -146,7 +149,7 @@ def summary(ablation, problems) -> pd.DataFrame:
 
 def test_verdicts_follow_the_data(ablation, summary):
     s = summary
-    claims, facts = analysis.claims(ablation, s, [2.0])
+    claims = est_claims.claims(ablation, s, [2.0])
     by_id = {c.id: c for c in claims}
     assert list(by_id) == ["EST-1", "EST-2", "EST-3", "EST-4"]
     # every key number of this study is bitwise reproducible (seeded draws and bootstrap)
@@ -162,15 +165,14 @@ def test_verdicts_follow_the_data(ablation, summary):
     fake.loc[pr, "bias_fraction_of_nbo"] = 0.0
     fake.loc[pr, "bias_fraction_low"] = -0.01
     fake.loc[pr, "bias_fraction_high"] = 0.01
-    assert analysis.claim_est4(fake)[0].verdict == "supported"
+    assert est_claims.claim_est4(fake).verdict == "supported"
     # a tree whose variance grows with N contradicts Prop. 1
     bad = s.copy()
     tree = (bad["scheme"] == "tree") & (bad["weighting"] == "uniform")
     bad.loc[tree, "var"] = bad.loc[tree, "N"] * 100.0
     bad.loc[tree, "var_low"] = bad.loc[tree, "var"] * 0.9
     bad.loc[tree, "var_high"] = bad.loc[tree, "var"] * 1.1
-    assert analysis.claim_est1(bad)[0].verdict == "not supported"
-    assert set(facts) >= {"tree_vs_independent", "chebyshev", "pruning_at_max_N"}
+    assert est_claims.claim_est1(bad).verdict == "not supported"
 
 
 # --- verdict rules on synthetic summaries with known answers ------------------------------
@@ -203,17 +205,17 @@ FLAT = {2: 100.0, 3: 40.0, 4: 90.0, 6: 45.0, 8: 95.0}
 
 def test_est1_supported_only_when_every_counted_slope_ci_is_below_zero():
     s = pd.DataFrame(_tree_rows("a", CLEAN) + _tree_rows("b", {N: 50.0 / N for N in CLEAN}))
-    c, _ = analysis.claim_est1(s)
+    c = est_claims.claim_est1(s)
     assert c.verdict == "supported"
     assert c.key.value == pytest.approx(-1.0) and c.key.ci_high < 0 and c.key.null == 0.0
     # one counted problem whose slope CI admits >= 0: not supported as a whole
     s = pd.DataFrame(_tree_rows("a", CLEAN) + _tree_rows("flat", FLAT))
-    c, _ = analysis.claim_est1(s)
+    c = est_claims.claim_est1(s)
     assert c.verdict == "inconclusive"
     assert "flat" in c.key.name and c.key.ci_low <= 0 <= c.key.ci_high
     # a significantly rising variance contradicts the claim
     s = pd.DataFrame(_tree_rows("a", CLEAN) + _tree_rows("up", {N: 10.0 * N for N in CLEAN}))
-    assert analysis.claim_est1(s)[0].verdict == "not supported"
+    assert est_claims.claim_est1(s).verdict == "not supported"
 
 
 def test_est1_names_every_problem_left_out_of_the_slope_evidence():
@@ -221,7 +223,7 @@ def test_est1_names_every_problem_left_out_of_the_slope_evidence():
     s = pd.DataFrame(
         _tree_rows("a", CLEAN) + _tree_rows("three", few, H=6) + _tree_rows("one", {2: 300.0}, H=8)
     )
-    c, _ = analysis.claim_est1(s)
+    c = est_claims.claim_est1(s)
     assert c.verdict == "supported"  # decided by "a" alone, the others named
     assert "three (H = 6): ran only at N = 2, 3, 4" in c.dropped and "admits 0" in c.dropped
     assert "one (H = 8): ran only at N = 2" in c.dropped and "no slope" in c.dropped
@@ -255,20 +257,20 @@ def _weighted_rows(problem: str, f_by_n: dict[int, float], half: float = 0.05) -
 
 def test_est2_rule_edge_cases():
     growing = {2: 0.6, 3: 0.8, 4: 0.9, 8: 1.0}
-    c = analysis.claim_est2(pd.DataFrame(_weighted_rows("p", growing)))
+    c = est_claims.claim_est2(pd.DataFrame(_weighted_rows("p", growing)))
     assert c.verdict == "not supported"
     assert c.key.value == pytest.approx(1.0) and "N = 8" in c.key.name
     # at J everywhere (CI contains 0 and excludes 1): supported
     at_j = {N: 0.0 for N in growing}
-    c = analysis.claim_est2(pd.DataFrame(_weighted_rows("p", at_j)))
+    c = est_claims.claim_est2(pd.DataFrame(_weighted_rows("p", at_j)))
     assert c.verdict == "supported" and c.key.ci_high < 1.0
     # a bias that shrinks toward J with N is not evidence against convergence to J
     shrinking = {2: 0.8, 3: 0.6, 4: 0.4, 8: 0.2}
-    assert analysis.claim_est2(pd.DataFrame(_weighted_rows("p", shrinking))).verdict == (
+    assert est_claims.claim_est2(pd.DataFrame(_weighted_rows("p", shrinking))).verdict == (
         "inconclusive"
     )
     # too few sizes cannot decide "not supported"; the problem is named
-    c = analysis.claim_est2(pd.DataFrame(_weighted_rows("short", {2: 0.5})))
+    c = est_claims.claim_est2(pd.DataFrame(_weighted_rows("short", {2: 0.5})))
     assert c.verdict == "inconclusive" and "short (1 tree size(s))" in c.dropped
 
 
@@ -302,7 +304,7 @@ def test_exact_schemes_are_not_reported_as_gains():
         g.loc["gauss_hermite", "gain_vs_mc"]
     )
     assert g.loc["sobol", "gain_vs_mc"] == pytest.approx(4.0) and not g.loc["sobol", "exact"]
-    text = analysis.gain_table(_gain_rows())
+    text = narrative.gain_table(_gain_rows())
     assert text.count("exact (error at rounding level)") == 2
     assert "e+" not in text and "inf" not in text.lower() and "nan" not in text.lower()
 
@@ -325,17 +327,17 @@ def _table_cells(md: str) -> list[dict[str, str]]:
 
 @pytest.fixture(scope="module")
 def section(ablation, summary):
-    tabs = analysis.tables(ablation, summary, [1.5, 2.0, 3.0])
-    return analysis.estimators_section(ablation, summary, [1.5, 2.0, 3.0], tabs), tabs
+    tabs = narrative.tables(ablation, summary, [1.5, 2.0, 3.0])
+    return narrative.estimators_section(ablation, summary, [1.5, 2.0, 3.0], tabs), tabs
 
 
 def test_section_body_budget_and_clean_numbers(section):
     sec, tabs = section
     assert len(sec.body.encode("utf-8")) <= 3000
     assert "|" not in sec.body  # tables live in the appendix
-    for name in analysis.FIGURES:
+    for name in narrative.FIGURES:
         assert f"(figures/{name}.png)" in sec.body
-    assert sec.figures == [f"{n}.png" for n in analysis.FIGURES]
+    assert sec.figures == [f"{n}.png" for n in narrative.FIGURES]
     texts = [sec.body, sec.appendix] + [
         x
         for c in sec.claims
@@ -451,7 +453,7 @@ def test_every_table_and_figure_is_declared_and_captioned(section):
     for stem in tabs:
         assert f'"{stem}"' in smk, stem
         assert (root / f"workflow/report/table_{stem}.rst").read_text(encoding="utf-8").strip()
-    for name in analysis.FIGURES:
+    for name in narrative.FIGURES:
         assert f'"{name}"' in smk, name
         assert (root / f"workflow/report/{name}.rst").read_text(encoding="utf-8").strip()
 
@@ -463,3 +465,113 @@ def test_section_round_trips_through_json(section, tmp_path):
     sec.save(tmp_path / "estimators.json")
     back = Section.load(tmp_path / "estimators.json")
     assert back.claims == sec.claims and back.body == sec.body and back.appendix == sec.appendix
+
+
+# --- the EST verdict rules on their boundaries (facts given directly) ------------------------
+
+EST1_OK = {"counted": 2, "slope_low_max": -1.5, "slope_high_max": -0.5, "rising": 0}
+
+
+@pytest.mark.parametrize(
+    ("facts", "verdict"),
+    [
+        ({**EST1_OK, "covered": 9, "cells": 10}, "supported"),  # coverage exactly 90%
+        ({**EST1_OK, "covered": 8, "cells": 10}, "inconclusive"),
+        ({**EST1_OK, "covered": 0, "cells": 0}, "inconclusive"),  # no derived variance
+        ({**EST1_OK, "slope_high_max": 0.0, "covered": 9, "cells": 9}, "inconclusive"),
+        (
+            {**EST1_OK, "slope_low_max": 0.0, "slope_high_max": 0.5, "covered": 9, "cells": 9},
+            "inconclusive",
+        ),
+        ({**EST1_OK, "slope_low_max": 1e-9, "covered": 9, "cells": 9}, "not supported"),
+        ({**EST1_OK, "rising": 1, "covered": 9, "cells": 9}, "not supported"),
+        (
+            {"counted": 0, "slope_low_max": -np.inf, "slope_high_max": -np.inf, "rising": 0}
+            | {"covered": 9, "cells": 9},
+            "inconclusive",
+        ),
+    ],
+)
+def test_est1_rule_boundaries(facts, verdict):
+    assert est_claims.RULE_EST1.verdict(facts) == verdict
+
+
+@pytest.mark.parametrize(
+    ("facts", "verdict"),
+    [
+        ({"problems": 2, "growing": 0, "at_j": 2}, "supported"),
+        ({"problems": 2, "growing": 0, "at_j": 1}, "inconclusive"),
+        ({"problems": 0, "growing": 0, "at_j": 0}, "inconclusive"),
+        ({"problems": 2, "growing": 1, "at_j": 1}, "not supported"),
+    ],
+)
+def test_est2_rule_boundaries(facts, verdict):
+    assert est_claims.RULE_EST2.verdict(facts) == verdict
+
+
+@pytest.mark.parametrize(
+    ("facts", "verdict"),
+    [
+        ({"cells": 4, "above": 0, "under": 4, "slopes": 2, "slopes_off": 0}, "supported"),
+        # an upper limit equal to its bound is not "below" it
+        ({"cells": 4, "above": 0, "under": 3, "slopes": 2, "slopes_off": 0}, "inconclusive"),
+        ({"cells": 4, "above": 0, "under": 4, "slopes": 0, "slopes_off": 0}, "inconclusive"),
+        ({"cells": 4, "above": 1, "under": 3, "slopes": 2, "slopes_off": 0}, "not supported"),
+        ({"cells": 4, "above": 0, "under": 4, "slopes": 2, "slopes_off": 1}, "not supported"),
+    ],
+)
+def test_est3_rule_boundaries(facts, verdict):
+    assert est_claims.rule_est3([2.0]).verdict(facts) == verdict
+
+
+def _pruned_top(lows_highs: list[tuple[float, float]]) -> pd.DataFrame:
+    return pd.DataFrame(
+        [{"bias_fraction_low": lo, "bias_fraction_high": hi} for lo, hi in lows_highs]
+    )
+
+
+@pytest.mark.parametrize(
+    ("cis", "verdict"),
+    [
+        ([(-0.1, 0.1), (0.0, 0.99)], "supported"),  # CI touching 0 contains it
+        ([(-0.1, 0.1), (0.0, 1.0)], "inconclusive"),  # a CI reaching 1 does not exclude it
+        ([(0.5, 0.9)], "inconclusive"),  # lower limit at 0.5 is not above it
+        ([(-0.1, 0.1), (0.5000001, 0.9)], "not supported"),
+        ([], "inconclusive"),
+    ],
+)
+def test_est4_rule_boundaries(cis, verdict):
+    top = (
+        _pruned_top(cis)
+        if cis
+        else _pruned_top([]).reindex(columns=["bias_fraction_low", "bias_fraction_high"])
+    )
+    assert est_claims.RULE_EST4.verdict(est_claims.facts_est4(top)) == verdict
+
+
+def test_printed_rules_come_from_the_rule_objects(section):
+    sec, _ = section
+    rules = [
+        est_claims.RULE_EST1,
+        est_claims.RULE_EST2,
+        est_claims.rule_est3([1.5, 2.0, 3.0]),
+        est_claims.RULE_EST4,
+    ]
+    assert [c.rule for c in sec.claims] == [r.text() for r in rules]
+    assert "docstring of `rsmhp.claims.estimators`" in sec.appendix
+
+
+def test_section_figures_are_the_drawn_figures():
+    from rsmhp.figures import estimators as figs
+
+    assert narrative.FIGURES == tuple(figs.FIGURES)
+
+
+def test_claims_of_empty_studies_say_so():
+    """No tree, no weighted tree, no pruned cells: key numbers count zero, verdicts inconclusive."""
+    s = pd.DataFrame(_gain_rows()).assign(N=0, M=0, H=2, var=1.0, var_low=0.9, var_high=1.1)
+    s = s.assign(var_theory=np.nan, limit=np.nan, bias=0.0, bias_low=0.0, bias_high=0.0)
+    s = s.assign(bias_fraction_of_nbo=0.0, bias_fraction_low=0.0, bias_fraction_high=0.0)
+    c1, c2, c4 = est_claims.claim_est1(s), est_claims.claim_est2(s), est_claims.claim_est4(s)
+    assert (c1.verdict, c2.verdict, c4.verdict) == ("inconclusive",) * 3
+    assert c1.key.value == c2.key.value == c4.key.value == 0.0

@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 import yaml
 
-from rsmhp import estimators, guards, lqg, samplers, seeding, stats
+from rsmhp import cost_estimators, designs, guards, lqg, seeding, stats
 from rsmhp.linear_quadratic import LinearQuadratic
 from rsmhp.sampling import (
     GaussianNoise,
@@ -27,17 +27,15 @@ from rsmhp.sampling import (
     top_m,
 )
 from rsmhp.uav import fused, kernel, kinematics, sensor, target
+from rsmhp.uav import methods as uav_methods
 from rsmhp.uav.kinematics import UAVParams
+from rsmhp.uav.methods.monte_carlo import MonteCarlo
+from rsmhp.uav.methods.nbo import NBO as NBOMethod
+from rsmhp.uav.methods.pruned_tree import PrunedTree
 from rsmhp.uav.planner import PlannerParams, PlanningProblem, lbfgsb, plan, shift_plan
 from rsmhp.uav.recording import ellipse_polygon
 from rsmhp.uav.sensor import SensorModel
-from rsmhp.uav.simulation import (
-    MethodSpec,
-    UAVSetup,
-    draw_scenario,
-    method_specs,
-    simulate_run,
-)
+from rsmhp.uav.simulation import UAVSetup, draw_scenario, simulate_run
 from rsmhp.uav.target import TargetModel
 from rsmhp.uav.tracker import Tracker
 
@@ -78,7 +76,7 @@ def _cfg(**changes) -> dict:
 
 
 SETUP = UAVSetup.from_config(_cfg())
-NBO = MethodSpec("nbo", "nbo", 1)
+NBO = NBOMethod()
 
 
 def _rng() -> np.random.Generator:
@@ -115,7 +113,7 @@ BAD = [
     ),
     (
         "simulate_run N_T=0",
-        lambda: simulate_run(SETUP, MethodSpec("rsmhp_nt0", "rsmhp", 0), 1, 1),
+        lambda: simulate_run(SETUP, MonteCarlo(0), 1, 1),
         V,
         r"n_traj \(N_T\) must be >= 1, got 0",
     ),
@@ -171,7 +169,7 @@ BAD = [
     ),
     (
         "monte_carlo n=0",
-        lambda: samplers.monte_carlo(_rng(), 0, 2, CHOL),
+        lambda: designs.monte_carlo(_rng(), 0, 2, CHOL),
         V,
         r"^n must be >= 1, got 0",
     ),
@@ -385,47 +383,47 @@ BAD = [
         V,
         r"^w must have shape \(\.\.\., 2\)",
     ),
-    # ---- samplers ----------------------------------------------------------------------------
+    # ---- designs -----------------------------------------------------------------------------
     (
         "monte_carlo H=0",
-        lambda: samplers.monte_carlo(_rng(), 4, 0, CHOL),
+        lambda: designs.monte_carlo(_rng(), 4, 0, CHOL),
         V,
         r"^H must be >= 1, got 0",
     ),
     (
         "monte_carlo chol nan",
-        lambda: samplers.monte_carlo(_rng(), 4, 2, np.array([[NAN]])),
+        lambda: designs.monte_carlo(_rng(), 4, 2, np.array([[NAN]])),
         V,
         r"^chol must be finite",
     ),
     (
         "monte_carlo rng None",
-        lambda: samplers.monte_carlo(None, 4, 2, CHOL),
+        lambda: designs.monte_carlo(None, 4, 2, CHOL),
         T,
         r"^rng must be a Generator",
     ),
     (
         "antithetic n=0",
-        lambda: samplers.antithetic(_rng(), 0, 2, CHOL),
+        lambda: designs.antithetic(_rng(), 0, 2, CHOL),
         V,
         r"^n must be >= 2, got 0",
     ),
-    ("sobol n=3", lambda: samplers.sobol(_rng(), 3, 2, CHOL), V, r"needs n a power of 2, got 3"),
+    ("sobol n=3", lambda: designs.sobol(_rng(), 3, 2, CHOL), V, r"needs n a power of 2, got 3"),
     (
         "cubature chol not square",
-        lambda: samplers.cubature(2, np.ones((2, 3))),
+        lambda: designs.cubature(2, np.ones((2, 3))),
         V,
         r"^chol must be a square",
     ),
     (
         "gauss_hermite q=0",
-        lambda: samplers.gauss_hermite(0, 2, CHOL),
+        lambda: designs.gauss_hermite(0, 2, CHOL),
         V,
         r"^q \(Gauss-Hermite nodes per dimension\) must be >= 1, got 0",
     ),
     (
         "gauss_hermite_order D=0",
-        lambda: samplers.gauss_hermite_order(16, 0),
+        lambda: designs.gauss_hermite_order(16, 0),
         V,
         r"^D must be >= 1, got 0",
     ),
@@ -518,37 +516,37 @@ BAD = [
     # ---- estimators ----------------------------------------------------------------------------
     (
         "uniform_estimate nan",
-        lambda: estimators.uniform_estimate([1.0, NAN]),
+        lambda: cost_estimators.uniform_estimate([1.0, NAN]),
         V,
         r"^cost must be finite, got nan at index 1",
     ),
     (
         "uniform_estimate bad axis",
-        lambda: estimators.uniform_estimate(np.ones(3), axis=2),
+        lambda: cost_estimators.uniform_estimate(np.ones(3), axis=2),
         V,
         r"^axis must be a valid axis of cost",
     ),
     (
         "likeliness_weights nan",
-        lambda: estimators.likeliness_weights([0.0, NAN]),
+        lambda: cost_estimators.likeliness_weights([0.0, NAN]),
         V,
         r"^log_likeliness must be finite or -inf",
     ),
     (
         "likeliness_weights all -inf",
-        lambda: estimators.likeliness_weights([-INF, -INF]),
+        lambda: cost_estimators.likeliness_weights([-INF, -INF]),
         V,
         r"^log_likeliness must not be -inf for every trajectory",
     ),
     (
         "weighted_estimate shape mismatch",
-        lambda: estimators.weighted_estimate(np.ones(5), np.zeros(1)),
+        lambda: cost_estimators.weighted_estimate(np.ones(5), np.zeros(1)),
         V,
         r"^cost and log_likeliness must have the same shape",
     ),
     (
         "nbo_estimate empty u",
-        lambda: estimators.nbo_estimate(MODEL_LQG, [0.0], []),
+        lambda: cost_estimators.nbo_estimate(MODEL_LQG, [0.0], []),
         V,
         r"control sequence u must have at least one step",
     ),
@@ -688,14 +686,14 @@ BAD = [
         r"^x_hat must have shape \(4,\), got \(3,\)",
     ),
     (
-        "target.sample_tree M=0",
-        lambda: target.sample_tree(X_HAT, P_HAT, 3, 4, 0, MODEL, _rng()),
+        "target.pruned_tree M=0",
+        lambda: target.pruned_tree(X_HAT, P_HAT, 3, 4, 0, MODEL, _rng()),
         V,
         r"^M \(trajectories kept\) must be >= 1, got 0",
     ),
     (
-        "target.sample_tree model",
-        lambda: target.sample_tree(X_HAT, P_HAT, 3, 4, 5, "model", _rng()),
+        "target.pruned_tree model",
+        lambda: target.pruned_tree(X_HAT, P_HAT, 3, 4, 5, "model", _rng()),
         T,
         r"^model must be a TargetModel",
     ),
@@ -873,45 +871,45 @@ BAD = [
     ),
     # ---- uav: simulation ---------------------------------------------------------------------
     (
-        "MethodSpec family",
-        lambda: MethodSpec("x", "bogus", 1),
+        "methods.from_spec family",
+        lambda: uav_methods.from_spec({"family": "bogus"}),
         V,
-        r"^MethodSpec\.family must be one of \('nbo', 'rsmhp', 'tree'\), got 'bogus'",
+        r"^method spec: unknown family 'bogus' \(allowed: \[",
     ),
     (
-        "MethodSpec tree without N",
-        lambda: MethodSpec("t", "tree", 10, None, 10),
+        "PrunedTree M=0",
+        lambda: PrunedTree(8, 0),
         V,
-        r"^MethodSpec\.n_branch \(N\) must be an integer >= 1 for the tree family",
+        r"^max_keep \(M\) must be >= 1, got 0",
     ),
     (
-        "MethodSpec tree M=0",
-        lambda: MethodSpec("t", "tree", 10, 8, 0),
+        "MonteCarlo N_T=2.5",
+        lambda: MonteCarlo(2.5),
         V,
-        r"^MethodSpec\.max_keep \(M\) must be >= 1, got 0",
+        r"^n_traj \(N_T\) must be an integer >= 1, got 2\.5",
     ),
     (
-        "MethodSpec nbo N_T=5",
-        lambda: MethodSpec("nbo", "nbo", 5),
+        "methods.from_config unknown key",
+        lambda: uav_methods.from_config({"nbo": True, "bogus": [1]}, "uav.methods"),
         V,
-        r"^MethodSpec\.n_traj \(N_T\) must be 1 for the nbo family",
+        r"^uav\.methods: unknown method key\(s\) \['bogus'\] \(allowed: \[",
     ),
     (
-        "MethodSpec rsmhp with M",
-        lambda: MethodSpec("r", "rsmhp", 10, None, 5),
+        "methods.from_name unknown",
+        lambda: uav_methods.from_name("rsmhp_ntx"),
         V,
-        r"^MethodSpec\.max_keep \(M\) must be None for the rsmhp family",
+        r"^method 'rsmhp_ntx' belongs to no registered family",
     ),
     (
-        "method_specs rsmhp_nt=[0]",
-        lambda: method_specs({"methods": {"nbo": True, "rsmhp_nt": [0], "tree": []}}),
+        "methods.from_config rsmhp_nt=[0]",
+        lambda: uav_methods.from_config({"nbo": True, "rsmhp_nt": [0], "tree": []}, "uav.methods"),
         V,
         r"^uav\.methods\.rsmhp_nt\[0\] must be >= 1, got 0",
     ),
     (
-        "method_specs tree N=2.5",
-        lambda: method_specs(
-            {"methods": {"nbo": True, "rsmhp_nt": [], "tree": [{"N": 2.5, "M": 4}]}}
+        "methods.from_config tree N=2.5",
+        lambda: uav_methods.from_config(
+            {"nbo": True, "rsmhp_nt": [], "tree": [{"N": 2.5, "M": 4}]}, "uav.methods"
         ),
         V,
         r"^uav\.methods\.tree\[0\]\.N must be an integer >= 1, got 2\.5",
@@ -952,7 +950,7 @@ BAD = [
         "simulate_run method dict",
         lambda: simulate_run(SETUP, {"name": "nbo"}, 1, 1),
         T,
-        r"^method must be a MethodSpec, got dict",
+        r"^method must be a Method, got dict",
     ),
     (
         "simulate_run observer",
@@ -1000,12 +998,12 @@ def test_h_equal_one_and_numpy_integers():
 def test_whole_number_floats_are_normalised():
     """3.0 counts as 3 (as in rsmhp.seeding's job ids); the result equals the int's."""
     assert lqg.state_variance(3.0, a=0.4, sigma=1.0) == lqg.state_variance(3, a=0.4, sigma=1.0)
-    w, wt = samplers.monte_carlo(np.random.default_rng(1), 8.0, 2, CHOL)
-    w2, wt2 = samplers.monte_carlo(np.random.default_rng(1), 8, 2, CHOL)
+    w, wt = designs.monte_carlo(np.random.default_rng(1), 8.0, 2, CHOL)
+    w2, wt2 = designs.monte_carlo(np.random.default_rng(1), 8, 2, CHOL)
     np.testing.assert_array_equal(w, w2)
     np.testing.assert_array_equal(wt, wt2)
-    assert MethodSpec("rsmhp_nt3", "rsmhp", 3.0).n_traj == 3
-    assert "rsmhp_nt3" in method_specs({"methods": {"nbo": False, "rsmhp_nt": [3.0], "tree": []}})
+    assert MonteCarlo(3.0).n_traj == 3
+    assert "rsmhp_nt3" in uav_methods.from_config({"nbo": False, "rsmhp_nt": [3.0], "tree": []})
 
 
 def test_sigma_zero_is_allowed_in_the_closed_forms():
@@ -1051,7 +1049,7 @@ def test_edge_bounds_are_allowed():
         QF.variance()
     )
     # -inf log-likeliness is a zero weight, not an error
-    np.testing.assert_array_equal(estimators.likeliness_weights([0.0, -np.inf]), [2.0, 0.0])
+    np.testing.assert_array_equal(cost_estimators.likeliness_weights([0.0, -np.inf]), [2.0, 0.0])
     assert seeding.job_rng(np.uint32(3), "e").random() == seeding.job_rng(3, "e").random()
 
 

@@ -11,8 +11,7 @@ import pytest
 from scipy import stats
 
 from rsmhp import lqg
-from rsmhp.linear_quadratic import LinearQuadratic
-from rsmhp.samplers import (
+from rsmhp.designs import (
     antithetic,
     cubature,
     gauss_hermite,
@@ -20,6 +19,7 @@ from rsmhp.samplers import (
     monte_carlo,
     sobol,
 )
+from rsmhp.linear_quadratic import LinearQuadratic
 from rsmhp.sampling import rollout, sample_independent, sample_tree
 
 from .conftest import PAPER, PAPER_U

@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from rsmhp import lqg
-from rsmhp.estimators import nbo_estimate, weighted_estimate
+from rsmhp.cost_estimators import nbo_estimate, weighted_estimate
 from rsmhp.sampling import sample_independent
 
 from .conftest import PAPER, PAPER_U
@@ -142,3 +142,39 @@ def test_closed_forms_reject_bad_parameters(kwargs, field):
 def test_empty_control_sequence_rejected():
     with pytest.raises(ValueError, match="u must be"):
         lqg.nbo_cost([], x0=0, a=0.5, r=1, target=1)
+
+
+def test_decision_closed_forms_and_their_pieces():
+    kw = {"x0": 0.3, "a": 0.4, "r": 10.0, "target": 1.0}
+    c = lqg.coefficients(3, 0.4)
+    np.testing.assert_array_equal(c, 0.6 ** np.arange(2, -1, -1))
+    assert 1.3**2 * c @ c == pytest.approx(lqg.state_variance(3, a=0.4, sigma=1.3))
+    assert lqg.optimal_cost(3, **kw, sigma=1.3) == lqg.exact_cost(
+        lqg.optimal_controls(3, **kw), **kw, sigma=1.3
+    )
+    # (4/3)^{H/2}/3 < 1 (weighting helps) exactly up to H = 7
+    assert lqg.weighted_regret_ratio(2) == pytest.approx(4 / 9)
+    assert lqg.weighted_regret_ratio(7) < 1 < lqg.weighted_regret_ratio(8)
+    assert lqg.weighted_expected_regret(50, 3, a=0.4, r=10.0, sigma=1.3) == pytest.approx(
+        lqg.expected_regret(50, 3, a=0.4, r=10.0, sigma=1.3) * (4 / 3) ** 1.5 / 3
+    )
+    assert lqg.regret_standard_error(2.0, 8) == pytest.approx(1.0)  # 2 * sqrt(2/8)
+    with pytest.raises(ValueError, match="R must be"):
+        lqg.regret_standard_error(1.0, 0)
+
+
+def test_lqg_model_is_the_one_definition():
+    from rsmhp.linear_quadratic import LinearQuadratic
+
+    model = lqg.LQGModel.from_config({**PAPER, "a": "0.5"})
+    assert model == lqg.LQGModel(**PAPER)
+    assert model.closed_form_args() == PAPER
+    assert lqg.LQGModel.from_config(PAPER, a=0.3).a == 0.3
+    assert "sigma" not in model.closed_form_args(sigma=False)
+    assert lqg.exact_cost(PAPER_U, **model.closed_form_args()) == pytest.approx(
+        LinearQuadratic.from_lqg(model, PAPER_U).exact_cost(), rel=1e-14
+    )
+    prob = LinearQuadratic.scalar_lqg(PAPER_U, **PAPER)
+    np.testing.assert_array_equal(prob.A, LinearQuadratic.from_lqg(model, PAPER_U).A)
+    with pytest.raises(ValueError, match="x0 must be finite"):
+        lqg.LQGModel(a=0.5, r=1.0, target=1.0, sigma=1.0, x0=float("nan"))

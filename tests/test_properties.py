@@ -45,8 +45,8 @@ import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
 
-from rsmhp import samplers
-from rsmhp.estimators import likeliness_weights, uniform_estimate, weighted_estimate
+from rsmhp import designs
+from rsmhp.cost_estimators import likeliness_weights, uniform_estimate, weighted_estimate
 from rsmhp.linear_quadratic import LinearQuadratic
 from rsmhp.sampling import rollout, rollout_cost, sample_independent, sample_tree
 from rsmhp.uav import fused, kernel
@@ -662,9 +662,9 @@ def check_rule(noise, weights, n, H, L, weight_roundings=1):
 )
 def test_stochastic_samplers_shapes_weights_and_antithetic_pairs(L, H, k, seed):
     rng = np.random.default_rng(seed)
-    noise, w = samplers.monte_carlo(rng, k, H, L)
+    noise, w = designs.monte_carlo(rng, k, H, L)
     check_rule(noise, w, k, H, L)
-    noise, w = samplers.antithetic(rng, 2 * k, H, L)
+    noise, w = designs.antithetic(rng, 2 * k, H, L)
     check_rule(noise, w, 2 * k, H, L)
     # pairs: L z and L (-z). Each entry is a d-term dot product, within d U (|L| |z|) of
     # exact, whichever BLAS path computes it; both: 2 d U (|L| |z|); z recovered by a solve
@@ -674,7 +674,7 @@ def test_stochastic_samplers_shapes_weights_and_antithetic_pairs(L, H, k, seed):
     bound = 4 * d * U * (np.abs(z) @ np.abs(L).T).reshape(k, H, d)
     assert np.all(np.abs(noise[:k] + noise[k:]) <= bound)
     m = 2 ** (k % 7)
-    noise, w = samplers.sobol(rng, m, H, L)
+    noise, w = designs.sobol(rng, m, H, L)
     check_rule(noise, w, m, H, L)
 
 
@@ -699,13 +699,13 @@ def test_deterministic_rules_reproduce_the_first_two_moments(L, H, q):
     structural error (a wrong node or weight) is O(1)."""
     d = L.shape[0]
     D = H * d
-    noise, w = samplers.cubature(H, L)
+    noise, w = designs.cubature(H, L)
     check_rule(noise, w, 2 * D, H, L)
     moments_exact(noise, w, L, 1e-10)
     # symmetric points: odd moments vanish exactly in pairs
     np.testing.assert_array_equal(noise[:D], -noise[D:])
-    q = min(q, samplers.gauss_hermite_order(4096, D) or 1)
-    noise, w = samplers.gauss_hermite(q, H, L)
+    q = min(q, designs.gauss_hermite_order(4096, D) or 1)
+    noise, w = designs.gauss_hermite(q, H, L)
     # each weight: a product of D one-dimensional weights, each normalised by numpy and
     # divided by sqrt(2 pi): <= q + 4 roundings each
     check_rule(noise, w, q**D, H, L, weight_roundings=D * (q + 4))
@@ -850,7 +850,7 @@ def cost_bound(sys, noise):
 @settings(BASE, max_examples=80)
 @given(sys=lq_systems(), n=st.integers(1, 50), seed=st.integers(0, 2**32 - 1))
 def test_rollout_cost_is_the_cost_of_rollout(sys, n, seed):
-    noise, _ = samplers.monte_carlo(np.random.default_rng(seed), n, sys.H, sys.noise.chol)
+    noise, _ = designs.monte_carlo(np.random.default_rng(seed), n, sys.H, sys.noise.chol)
     traj = rollout(sys, sys.x0, sys.u, noise)
     np.testing.assert_array_equal(rollout_cost(sys, sys.x0, sys.u, noise), traj.cost)
     assert traj.states.shape == (n, sys.H + 1, sys.d)

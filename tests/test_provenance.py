@@ -25,3 +25,41 @@ def test_provenance_outside_a_git_checkout(tmp_path):
     prov = provenance({"threads": 1}, root=tmp_path)
     assert prov["commit"] == "unknown (not a git checkout)"
     assert prov["uncommitted changes (outside paper/)"] == "unknown"
+
+
+def test_code_provenance_lists_each_rules_recorded_digest_and_its_modules(tmp_path):
+    """Per rule: the digests its tables record (with the files), the digest its code gives
+    now and the modules behind it; results/paper (the published copy) is not read."""
+    import pandas as pd
+
+    from rsmhp.code_digest import describe
+    from rsmhp.io import stamping, write_csv, write_parquet
+    from rsmhp.provenance import code_provenance
+
+    src = tmp_path / "src" / "rsmhp"
+    src.mkdir(parents=True)
+    (src / "__init__.py").write_text("")
+    (src / "model.py").write_text("def f():\n    return 1\n")
+    scripts = tmp_path / "workflow" / "scripts"
+    scripts.mkdir(parents=True)
+    (scripts / "simulate.py").write_text("from rsmhp.model import f\n")
+    now = describe(scripts / "simulate.py", tmp_path / "src")
+    results = tmp_path / "results"
+    df = pd.DataFrame({"x": [1.0]})
+    with stamping(f"simulate:{now.digest}"):
+        write_csv(df, results / "sim" / "a.csv")
+        write_parquet(df, results / "sim" / "a.parquet")
+    with stamping("summarise:0123456789ab"):  # no scripts/summarise.py: no current digest
+        write_csv(df, results / "summary.csv")
+        write_csv(df, results / "paper" / "copy.csv")
+    code = code_provenance(results, scripts, extra={"report": ("fedcba987654", ["p.json"])})
+    assert code["rules"]["simulate"] == {
+        "recorded": {now.digest: [str(results / "sim/a.csv"), str(results / "sim/a.parquet")]},
+        "current": now.digest,
+        "modules": ["rsmhp", "rsmhp.model", "simulate.py"],
+    }
+    assert code["rules"]["summarise"] == {
+        "recorded": {"0123456789ab": [str(results / "summary.csv")]}
+    }
+    assert code["rules"]["report"] == {"recorded": {"fedcba987654": ["p.json"]}}
+    assert code["modules"] == {m: d[:12] for m, d in now.modules.items()}

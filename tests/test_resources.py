@@ -9,9 +9,10 @@ import numpy as np
 import pytest
 import yaml
 
+from rsmhp import lqg
 from rsmhp.config import CONFIG_PATH
 from rsmhp.experiments import decisions_lqg, estimators
-from rsmhp.experiments.lqg import LQGParams, _estimate_row
+from rsmhp.experiments.lqg import estimate_row
 from rsmhp.resources import FIXED_BYTES, estimate_mb, memory_problems, working_set_bytes
 
 MODEL = {"x0": 0.0, "a": 0.5, "r": 10.0, "target": 1.0, "sigma": 1.0}
@@ -28,8 +29,8 @@ def _peak(fn) -> int:
 
 @pytest.mark.parametrize(("P", "H"), [(20000, 2), (20000, 10), (5000, 40)])
 def test_lqg_estimate_bounds_the_measured_peak(P, H):
-    params = LQGParams(**MODEL)
-    peak = _peak(lambda: _estimate_row(1, "mem", params, np.full(H, 0.3), P, 0))
+    model = lqg.LQGModel(**MODEL)
+    peak = _peak(lambda: estimate_row(1, "mem", model, np.full(H, 0.3), P, 0))
     bound = working_set_bytes(P, H)
     assert peak <= bound <= 3 * peak + FIXED_BYTES
 
@@ -38,7 +39,7 @@ def test_lqg_estimate_bounds_the_measured_peak(P, H):
 def test_decision_cell_estimate_bounds_the_measured_peak(H):
     cell = decisions_lqg.RegretCell(0.5, H, "mc", P=20000)
     model = {k: MODEL[k] for k in ("x0", "r", "target", "sigma")}
-    peak = _peak(lambda: list(decisions_lqg._cell_rows(cell, model, 1, 1)))
+    peak = _peak(lambda: list(decisions_lqg.cell_rows(cell, model, 1, 1)))
     assert peak <= working_set_bytes(cell.P, H) <= 3 * peak + FIXED_BYTES
 
 
@@ -62,9 +63,9 @@ NCV = {
 )
 def test_ablation_estimate_bounds_the_measured_peak(spec, point):
     prob = estimators.build_problem(spec, MODEL)
-    leaves = estimators._n_trajectories(point, prob)
+    leaves = estimators.n_trajectories(point, prob)
     P = point.M * point.N if point.scheme == "pruned" else leaves
-    peak = _peak(lambda: list(estimators._rows(point, prob, spec, 1, 1)))
+    peak = _peak(lambda: list(estimators.ablation_rows(point, prob, spec, 1, 1)))
     assert peak <= working_set_bytes(P, prob.H, prob.d) <= 4 * peak + FIXED_BYTES
 
 

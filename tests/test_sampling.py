@@ -7,7 +7,7 @@ import pytest
 from scipy import stats
 
 from rsmhp import lqg
-from rsmhp.estimators import (
+from rsmhp.cost_estimators import (
     likeliness_weights,
     nbo_estimate,
     uniform_estimate,

@@ -59,8 +59,10 @@ def test_weighted_gradient_is_the_weighted_sum_of_hypothesis_gradients(rng, sens
     tail = (MODEL.dt, MODEL.Q, sensor)
     c, g = fused.cost_and_grad(x, *args, txy, *tail, weights=w)
     parts = [fused.cost_and_grad(x, *args, txy[i : i + 1], *tail) for i in range(6)]
-    assert c[0] == pytest.approx(sum(wi * p[0][0] for wi, p in zip(w, parts)), rel=1e-12)
-    ref = sum(wi * p[1][0] for wi, p in zip(w, parts))
+    assert c[0] == pytest.approx(
+        sum(wi * p[0][0] for wi, p in zip(w, parts, strict=True)), rel=1e-12
+    )
+    ref = sum(wi * p[1][0] for wi, p in zip(w, parts, strict=True))
     np.testing.assert_allclose(g[0], ref, rtol=0, atol=1e-12 * np.abs(ref).max())
 
 

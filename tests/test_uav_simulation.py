@@ -13,9 +13,11 @@ import yaml
 from rerun.chunk import RrdReader
 
 from rsmhp.analysis import uav as analysis
+from rsmhp.claims import uav as uav_claims
 from rsmhp.experiments.uav import NONDETERMINISTIC_COLUMNS, RUN_COLUMNS, run_chunk
 from rsmhp.ledger import Section
 from rsmhp.markdown import fmt
+from rsmhp.narrative import uav as narrative
 from rsmhp.palette import method_colour, method_label, method_rgb
 from rsmhp.report import render_appendix, render_report
 from rsmhp.uav import methods as uav_methods
@@ -169,7 +171,7 @@ def test_verdict_rules(shift, verdict):
     # CI half-width is about 1.96 * 0.3 / sqrt(200) = 0.04, far from |shift| = 0.5
     runs = _runs(shift + _centred_noise(200, 0.3), tree=True)
     summary, paired = _analyse(runs)
-    claims = {c.id: c for c in analysis.uav_claims(summary, paired)}
+    claims = {c.id: c for c in uav_claims.uav_claims(summary, paired)}
     # UAV-3: d = e(N_T=250) - e(tree) = -shift per run: the opposite verdict
     opposite = {"supported": "not supported", "not supported": "supported"}.get(verdict, verdict)
     assert {k: c.verdict for k, c in claims.items()} == {
@@ -200,20 +202,21 @@ def test_verdict_rules(shift, verdict):
     ],
 )
 def test_verdict_rule_edges(lo, hi, expected):
-    assert analysis.verdict(lo, hi) == expected
+    facts = {f"{uav_claims.KEY}_low": lo, f"{uav_claims.KEY}_high": hi}
+    assert uav_claims.paired_rule("A", "B").verdict(facts) == expected
     # the same through uav_claims, from a synthetic paired table with exactly this CI
     summary, paired = _analyse(_runs(_centred_noise(20, 0.3)), n_boot=200)
     key = (paired["method"] == "rsmhp_nt250") & (paired["baseline"] == "nbo")
     paired.loc[key, ["ci_low", "ci_high", "mean_diff"]] = [lo, hi, (lo + hi) / 2]
-    uav2 = next(c for c in analysis.uav_claims(summary, paired) if c.id == "UAV-2")
+    uav2 = next(c for c in uav_claims.uav_claims(summary, paired) if c.id == "UAV-2")
     assert uav2.verdict == expected
     assert (uav2.key.ci_low, uav2.key.ci_high) == (lo, hi)
 
 
 def _section(runs: pd.DataFrame, n_boot: int = 500):
     summary, paired = _analyse(runs, n_boot)
-    tables = analysis.uav_tables(summary, paired)
-    return analysis.uav_section(summary, paired, tables, DEFAULT_UAV, n_boot, runs), tables
+    tables = narrative.uav_tables(summary, paired)
+    return narrative.uav_section(summary, paired, tables, DEFAULT_UAV, n_boot, runs), tables
 
 
 def _no_bad_numbers(text: str) -> None:
@@ -231,9 +234,9 @@ def test_section_budget_and_formatting(tmp_path, zero_diff):
     runs = _runs(diff, tree=True, base=base)
     section, tables = _section(runs)
     assert len(section.body.encode("utf-8")) <= 2600
-    for stem in analysis.FIGURES:
+    for stem in narrative.FIGURES:
         assert f"](figures/{stem}.png)" in section.body
-    assert section.figures == [f"{f}.png" for f in analysis.FIGURES]
+    assert section.figures == [f"{f}.png" for f in narrative.FIGURES]
     assert "| UAV-" not in section.body and "### Claims" not in section.body
     clipped = re.findall(
         r"1 run per curve beyond [\d.]+ m not shown \(up to 61.[78] m\)", section.body
@@ -340,6 +343,6 @@ def test_figure_lists_agree():
     """The workflow's figure list (rule outputs, report inputs) is the section's FIGURES."""
     smk = (ROOT / "workflow" / "rules" / "uav.smk").read_text()
     listed = re.search(r"UAV_FIGURES = \[(.*?)\]", smk, re.S).group(1)
-    assert re.findall(r'"(\w+)"', listed) == list(analysis.FIGURES)
-    for stem in analysis.FIGURES:
+    assert re.findall(r'"(\w+)"', listed) == list(narrative.FIGURES)
+    for stem in narrative.FIGURES:
         assert (ROOT / "workflow" / "report" / f"{stem}.rst").read_text().strip()

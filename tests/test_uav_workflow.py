@@ -8,10 +8,10 @@ import pytest
 import yaml
 from rerun.chunk import RrdReader
 
-from rsmhp.analysis.uav import FIGURES
 from rsmhp.experiments.uav import NONDETERMINISTIC_COLUMNS
 from rsmhp.ledger import Section
 from rsmhp.markdown import fmt
+from rsmhp.narrative.uav import FIGURES
 from tests.test_workflow import TINY, snakemake
 
 pytestmark = pytest.mark.workflow

@@ -34,14 +34,17 @@ CSVS = [
 
 
 def snakemake(
-    workdir: Path, *args: str, configfiles: tuple[Path, ...] = (TINY,)
+    workdir: Path,
+    *args: str,
+    configfiles: tuple[Path, ...] = (TINY,),
+    snakefile: Path = ROOT / "Snakefile",
 ) -> subprocess.CompletedProcess:
     cmd = [
         sys.executable,
         "-m",
         "snakemake",
         "-s",
-        str(ROOT / "Snakefile"),
+        str(snakefile),
         "-d",
         str(workdir),
         "--configfile",
@@ -436,3 +439,148 @@ def test_a_run_writes_only_under_results(run_j2):
     written = {p.name for p in run_j2.iterdir()} - {".snakemake"}
     assert written == {"results"}, written
     assert (run_j2 / "results/paper/replication.md").exists()
+
+
+# ------------------------------------------------------------------ reruns after code edits
+
+TARGET_RULES = {"all", "lqg", "estimators", "uav", "decisions"}
+SIMULATIONS = {
+    "lqg_convergence",
+    "lqg_nbo_error",
+    "estimators_ablation",
+    "uav_simulate",
+    "decisions_lqg",
+    "decisions_uav",
+    "decisions_map_cell",
+}
+
+
+def _dry_run(wf: Path, run: Path) -> tuple[set[str], set[str]]:
+    """(every rule `snakemake -n` schedules, the rules among them whose reason is a params
+    change), target rules aside."""
+    res = snakemake(run, "-n", snakefile=wf / "Snakefile")
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-3000:]
+    if "Nothing to be done" in out:
+        return set(), set()
+    stats = out.split("Job stats:", 1)[1].split("\ntotal", 1)[0]
+    scheduled = set(re.findall(r"^(\w+)\s+\d+$", stats, flags=re.M)) - {"job"}
+    params = {
+        rule
+        for rule, block in re.findall(r"^(?:local)?rule (\w+):\n((?:    .*\n)*)", out, flags=re.M)
+        if "reason: Params have changed" in block
+    }
+    return scheduled - TARGET_RULES, params
+
+
+def _rule_graph(wf: Path, run: Path) -> tuple[dict[str, str], dict[str, set[str]]]:
+    """(rule -> its script, rule -> the rules that use its outputs) of the workflow copy."""
+    scripts = {}
+    for smk in (wf / "workflow/rules").glob("*.smk"):
+        for block in re.split(r"\n(?=rule )", smk.read_text()):
+            m = re.match(r'rule (\w+):.*?script:\s*\n\s*"\.\./scripts/(\w+\.py)"', block, re.S)
+            if m:
+                scripts[m.group(1)] = m.group(2)
+    res = snakemake(run, "--rulegraph", snakefile=wf / "Snakefile")
+    assert res.returncode == 0, res.stderr[-3000:]
+    labels = dict(re.findall(r'^\s*(\d+)\[label = "(\w+)"', res.stdout, flags=re.M))
+    users: dict[str, set[str]] = {name: set() for name in labels.values()}
+    for a, b in re.findall(r"^\s*(\d+) -> (\d+)", res.stdout, flags=re.M):
+        users[labels[a]].add(labels[b])
+    return scripts, users
+
+
+def _downstream(rules: set[str], users: dict[str, set[str]]) -> set[str]:
+    out, todo = set(rules), list(rules)
+    while todo:
+        for nxt in users.get(todo.pop(), ()):
+            if nxt not in out:
+                out.add(nxt)
+                todo.append(nxt)
+    return out
+
+
+def test_code_edits_rerun_exactly_the_rules_that_import_the_code(run_j2, tmp_path):
+    """Issue 18: a rule reruns when a module its script imports (transitively) changes, and
+    so does everything downstream; nothing else does, and comments, formatting or a touch
+    rerun nothing. On a copy of the workflow (its src/ included: the rules' `code` params are
+    digests of the copy's src/) and of the finished tiny run."""
+    from rsmhp.code_digest import describe
+
+    wf, run = tmp_path / "wf", tmp_path / "run"
+    wf.mkdir()
+    shutil.copy2(ROOT / "Snakefile", wf / "Snakefile")
+    for d in ("workflow", "config", "src"):
+        shutil.copytree(ROOT / d, wf / d, ignore=shutil.ignore_patterns("*.pyc", "*.egg-info"))
+    shutil.copytree(run_j2, run, symlinks=True)
+    assert _dry_run(wf, run) == (set(), set())  # the copy is the same code: nothing to do
+    scripts, users = _rule_graph(wf, run)
+
+    def edit(rel: str) -> tuple[set[str], set[str], set[str]]:
+        """Add a harmless function to src/rsmhp/<rel>; (scheduled, params changed, the rules
+        whose scripts import the module); the module restored."""
+        path = wf / "src/rsmhp" / rel
+        text = path.read_text()
+        path.write_text(text + "\n\ndef _probe_of_a_code_edit():\n    return None\n")
+        try:
+            scheduled, params = _dry_run(wf, run)
+        finally:
+            path.write_text(text)
+        module = "rsmhp." + rel.removesuffix(".py").replace("/", ".")
+        importers = {
+            rule
+            for rule, script in scripts.items()
+            if rule in users
+            and module in describe(wf / "workflow/scripts" / script, wf / "src").modules
+        }
+        assert params == importers, module  # Snakemake's reason: the `code` param changed
+        assert scheduled == _downstream(importers, users) - TARGET_RULES, module
+        return scheduled, params, importers
+
+    # (a) a model module: the simulations that import it and what is made from them
+    scheduled, params, _ = edit("uav/kinematics.py")
+    assert {"uav_simulate", "decisions_uav", "decisions_map_cell"} <= params
+    assert {"uav_collect", "uav_summary", "report"} <= scheduled
+    assert not {"lqg_convergence", "lqg_nbo_error", "estimators_ablation", "decisions_lqg"} & (
+        scheduled
+    )
+    # (b) an analysis module: aggregation (and what uses it) only, no simulation
+    scheduled, params, _ = edit("analysis/lqg.py")
+    assert "lqg_summary" in params and "report" in scheduled
+    assert not scheduled & SIMULATIONS and not any(r.endswith("recording") for r in scheduled)
+    # (c) a figure module: figure rules only, and the report that copies the figures
+    scheduled, params, _ = edit("figures/uav.py")
+    assert "uav_figures" in params
+    assert scheduled <= {r for r in users if r.endswith("_figures")} | {"report"}
+    # comments, formatting and modification times alone rerun nothing
+    kinematics = wf / "src/rsmhp/uav/kinematics.py"
+    kinematics.write_text("# a comment\n" + kinematics.read_text().replace("\n\n\n", "\n\n\n\n"))
+    (wf / "src/rsmhp/uav/fused.py").touch()
+    assert _dry_run(wf, run) == (set(), set())
+
+
+def test_provenance_records_the_code_of_every_rule(run_j2):
+    """results/provenance.json: per rule the digest its outputs record, which the code now
+    gives, and the modules behind it; every table a rule wrote records that rule."""
+    from rsmhp.code_digest import describe
+    from rsmhp.io import recorded_code
+
+    code = json.loads((run_j2 / "results/provenance.json").read_text())["code"]
+    rules = code["rules"]
+    assert SIMULATIONS | {"lqg_summary", "estimators_summary", "uav_collect", "report"} <= set(
+        rules
+    )
+    for rule, entry in rules.items():
+        ((digest, files),) = entry["recorded"].items()  # one code version per rule
+        assert entry["current"] == digest, rule
+        now = describe(ROOT / f"workflow/scripts/{rule}.py", ROOT / "src")
+        assert digest == now.digest and entry["modules"] == list(now.modules), rule
+        assert all(code["modules"][m] == d[:12] for m, d in now.modules.items())
+        for f in files:
+            if not f.endswith("provenance.json"):
+                assert recorded_code(run_j2 / f) == f"{rule}:{digest}", f
+    runs = (run_j2 / "results/uav/runs.csv").read_text().splitlines()
+    assert runs[0].endswith(",plan_seconds,code")
+    assert runs[1].endswith(f",uav_collect:{rules['uav_collect']['current']}")
+    appendix = (run_j2 / "results/paper/appendix.md").read_text()
+    assert f"lqg_convergence {rules['lqg_convergence']['current']}" in appendix

@@ -9,8 +9,8 @@ Sub-modules
 Core (model-independent)
   seeding           stable, order-independent random streams (SeedSequence keyed on job ids)
   sampling          tree / pruned-tree / non-overlapping trajectory sampling with likeliness
-  samplers          fixed-budget noise samplers: MC, antithetic, Sobol', cubature, Gauss-Hermite
-  estimators        uniform and likeliness-weighted averages, NBO
+  designs           fixed-budget noise designs: MC, antithetic, Sobol', cubature, Gauss-Hermite
+  cost_estimators   uniform and likeliness-weighted averages, NBO
   linear_quadratic  linear-Gaussian systems with quadratic cost and their exact oracles
   stats             confidence intervals (mean, RMSE, binomial) and log-log slope fits
   guards            argument checks of the public entry points (ValueError / TypeError naming
@@ -18,14 +18,22 @@ Core (model-independent)
 Models
   lqg               the scalar "oven" LQG case study and all its closed forms
   uav               UAV target tracking: kinematics, target, sensor, tracker (filterpy),
-                    kernel (numpy oracle), fused (compiled cost + exact gradient), planner,
-                    simulation, recording
+                    kernel (numpy oracle), fused (compiled weighted cost + exact gradient),
+                    planner (Planner protocol, L-BFGS-B), methods (registry of planning
+                    methods, one module per family), simulation, recording
 Stages of the pipeline (one module per model and stage)
   experiments       lqg, estimators, uav, decisions_lqg, decisions_uav: config -> tidy tables
-  analysis          lqg, estimators, uav, decisions: tables -> summaries, claims, sections
+  analysis          lqg, estimators, uav, decisions: tables -> statistics (summaries, fits, CIs)
   figures           lqg, estimators, uav, decisions: seaborn figures (PNG + PDF)
   recording         rerun recordings of sampled trajectory trees
-  report            claims (key number, CI, verdict rule), the ledger, main text and appendix
+  claims            per study: the claims (key number + verdict rule) from the statistics
+  narrative         per study: the report section's prose, tables and appendix (Markdown)
+  ledger            the claims data model: KeyNumber, Claim, Section
+  verdicts          verdict rules as objects (Rule, Case, at_most, ci_side): text + evaluation
+  markdown          number formatting and Markdown tables
+  provenance        commit, config hash, package versions, BLAS and CPU of a run
+  report            renders the main text, appendix, claims and glance table from the sections
+  readme            splices the glance table into README.md (``make publish``)
   verify            a run's claims against the committed reference (``make verify``)
   palette           one colour and label per method, for every figure and recording
 Workflow support
@@ -35,6 +43,7 @@ Workflow support
   io                atomic, umask-honouring writers and checked readers
   parallel          joblib fan-out that honours a thread budget without oversubscribing BLAS
   pipeline          logging of rule scripts
+  code_digest       content digest of the package code each rule imports (reruns never stale)
 """
 
 __version__ = "0.1.0"

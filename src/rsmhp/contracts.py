@@ -20,12 +20,18 @@ the file):
 
 Every failure raises :class:`rsmhp.io.IntermediateFileError` naming the file, the column or
 the missing keys (a few examples and the count), and the rule that produces the file.
+
+Code. Every table a rule writes records ``<rule>:<digest>`` of the code that made it
+(:mod:`rsmhp.io`, :mod:`rsmhp.code_digest`). Before a rule computes anything,
+:func:`check_codes` (called by :func:`rsmhp.pipeline.rule_logging` on all the rule's inputs)
+refuses inputs made by different versions of one producing rule's code (a partial rerun
+that mixed them) or by code other than what the producing rule's code gives now (stale).
 """
 
 from __future__ import annotations
 
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -33,9 +39,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rsmhp.io import IntermediateFileError, read_table
+from rsmhp.io import IntermediateFileError, read_table, recorded_code
 
-__all__ = ["Contract", "check_table", "read_checked"]
+__all__ = ["Contract", "check_codes", "check_table", "read_checked"]
 
 _EXAMPLES = 3
 
@@ -250,3 +256,52 @@ def read_checked(path: str | os.PathLike, contract: Contract) -> pd.DataFrame:
         what = str(exc).removeprefix(f"{path}: ").split("; delete it")[0]
         raise _fail(path, contract, what) from exc
     return check_table(df, path, contract)
+
+
+def _files_text(files: Sequence[str]) -> str:
+    shown = ", ".join(files[:_EXAMPLES])
+    return shown + (f" and {len(files) - _EXAMPLES} more" if len(files) > _EXAMPLES else "")
+
+
+def check_codes(
+    paths: Iterable[str | os.PathLike], current: Callable[[str], str | None] | None = None
+) -> dict[str, str]:
+    """Refuse ``paths`` (a rule's inputs) unless, for every producing rule, the files it made
+    record one and the same code digest and, where ``current(rule)`` gives the digest of that
+    rule's code now, that one. Files that record no code (not tables, or written outside a
+    rule) are not checked. Returns ``{path: "<rule>:<digest>"}`` of the recorded files.
+
+    Raises :class:`rsmhp.io.IntermediateFileError` naming the files, their digests and the
+    rule to rerun (nothing is deleted or rewritten)."""
+    stamps = {str(p): s for p in paths if (s := recorded_code(p)) is not None}
+    by_rule: dict[str, dict[str, list[str]]] = {}
+    for path, stamp in stamps.items():
+        rule, _, digest = stamp.rpartition(":")
+        by_rule.setdefault(rule or "?", {}).setdefault(digest, []).append(path)
+    problems = []
+    for rule, digests in sorted(by_rule.items()):
+        now = current(rule) if current is not None and rule != "?" else None
+        rerun = (
+            f"rerun rule {rule} (e.g. `snakemake -j2 --forcerun {rule}`)"
+            if rule != "?"
+            else "rerun the rule that produces them"
+        )
+        if len(digests) > 1:
+            made = "; ".join(
+                f"{_files_text(files)} by code {d}" for d, files in sorted(digests.items())
+            )
+            now_text = f" (the current code gives {now})" if now else ""
+            problems.append(
+                f"{made}: inputs made by different versions of the code of rule {rule}"
+                f"{now_text}, e.g. by a partial rerun; nothing was computed: {rerun}"
+            )
+        elif now is not None and now not in digests:
+            ((digest, files),) = digests.items()
+            problems.append(
+                f"{_files_text(files)}: made by code {digest} of rule {rule}, but its code now "
+                f"gives {now} (an rsmhp module it imports changed since); nothing was "
+                f"computed: {rerun}"
+            )
+    if problems:
+        raise IntermediateFileError("\n".join(problems))
+    return stamps

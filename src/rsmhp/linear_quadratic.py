@@ -34,6 +34,7 @@ from functools import cached_property
 import numpy as np
 
 from rsmhp import guards
+from rsmhp.lqg import LQGModel
 from rsmhp.sampling import GaussianNoise
 
 __all__ = ["LinearQuadratic", "QuadraticForm"]
@@ -300,26 +301,28 @@ class LinearQuadratic:
             object.__setattr__(self, key, val)
 
     @classmethod
+    def from_lqg(cls, model: LQGModel, u) -> LinearQuadratic:
+        """The oven problem :class:`rsmhp.lqg.LQGModel` with controls ``u`` (H,) in this
+        general form: ``A = 1-a, B = a, Σ = σ², Q = 0, R = 1, Q_f = r``, target and x0."""
+        return cls(
+            A=[[1 - model.a]],
+            B=[[model.a]],
+            Sigma=[[model.sigma**2]],
+            Q=[[0.0]],
+            R=[[1.0]],
+            Qf=[[model.r]],
+            target=[model.target],
+            x0=[model.x0],
+            u=np.reshape(u, (-1, 1)),
+        )
+
+    @classmethod
     def scalar_lqg(
         cls, u, *, x0: float, a: float, r: float, target: float, sigma: float
     ) -> LinearQuadratic:
-        """The paper's oven problem (:mod:`rsmhp.lqg`) in this general form."""
-        guards.real("a", a, lo=0.0, hi=1.0, lo_open=True, hi_open=True)
-        guards.real("r", r, lo=0.0)
-        guards.real("sigma", sigma, lo=0.0, lo_open=True)
-        guards.real("x0", x0)
-        guards.real("target", target)
-        return cls(
-            A=[[1 - a]],
-            B=[[a]],
-            Sigma=[[sigma**2]],
-            Q=[[0.0]],
-            R=[[1.0]],
-            Qf=[[r]],
-            target=[target],
-            x0=[x0],
-            u=np.reshape(u, (-1, 1)),
-        )
+        """The paper's oven problem from its constants: :meth:`from_lqg` of
+        :class:`rsmhp.lqg.LQGModel` (which checks them)."""
+        return cls.from_lqg(LQGModel(a=a, r=r, target=target, sigma=sigma, x0=x0), u)
 
     @property
     def H(self) -> int:

@@ -47,11 +47,26 @@ NBO's cost and the exact cost have the same minimiser (certainty equivalence):
   regret :math:`\kappa v_H/N` times :math:`\chi^2_1`, the regret of only :math:`N`
   independent trajectories; antithetic pairs and symmetric sigma points give
   :math:`\bar e = 0`, zero regret.
+* with likeliness weights :math:`\omega_i \propto \phi(w^i)` (the density of the whole
+  sequence) the self-normalised :math:`\bar e` of P i.i.d. trajectories has variance
+  :math:`E[\phi^2 (c^\top w)^2] / (P\, E[\phi]^2) = (4/3)^{H/2} v_H / (3P)` to first order
+  in 1/P, so the mean regret is :math:`\kappa v_H (4/3)^{H/2}/(3P)`, the uniform one times
+  :math:`(4/3)^{H/2}/3` (below 1, i.e. weighting helps, for :math:`H \le 7`).
+* a regret that is a mean :math:`\rho` times a :math:`\chi^2_1` variable has variance
+  :math:`2\rho^2`, so a mean of R independent regrets has standard error
+  :math:`\rho\sqrt{2/R}`.
+
+:class:`LQGModel` is the one definition of the problem's constants (a, r, T, σ, x_0); it is
+the simulated system and gives the keyword arguments of the closed forms
+(:meth:`LQGModel.closed_form_args`). :meth:`rsmhp.linear_quadratic.LinearQuadratic.from_lqg`
+writes it in the general linear-quadratic form.
 """
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
+from typing import Any, Self
 
 import numpy as np
 
@@ -61,6 +76,7 @@ from rsmhp.sampling import GaussianNoise
 __all__ = [
     "LQGModel",
     "chebyshev_bound",
+    "coefficients",
     "cost_variance",
     "exact_cost",
     "expected_regret",
@@ -68,12 +84,16 @@ __all__ = [
     "nbo_cost",
     "nbo_error",
     "optimal_controls",
+    "optimal_cost",
     "regret",
     "regret_gain",
+    "regret_standard_error",
     "sample_argmin",
     "state_mean",
     "state_variance",
+    "weighted_expected_regret",
     "weighted_limit",
+    "weighted_regret_ratio",
 ]
 
 
@@ -208,6 +228,13 @@ def _coefficients(H: int, a: float) -> np.ndarray:
     return (1.0 - a) ** np.arange(H - 1, -1, -1, dtype=float)
 
 
+def coefficients(H: int, a: float) -> np.ndarray:
+    r""":math:`c_k = (1-a)^{H-1-k}`, k = 0..H-1, shape (H,): the weight of :math:`a u_k + w_k`
+    in :math:`x_H`, so that the final state's noise is :math:`c^\top w`."""
+    _check(a=a)
+    return _coefficients(guards.positive_int("H", H), a)
+
+
 def _optimal(H: int, x0: float, a: float, r: float, target: float) -> np.ndarray:
     """:func:`optimal_controls` without the argument checks."""
     c = _coefficients(H, a)
@@ -220,6 +247,13 @@ def optimal_controls(H: int, *, x0: float, a: float, r: float, target: float) ->
     minimiser (it differs from J by the constant :math:`r v_H`)."""
     _check(a=a, r=r, x0=x0, target=target)
     return _optimal(guards.positive_int("H", H), x0, a, r, target)
+
+
+def optimal_cost(H: int, *, x0: float, a: float, r: float, target: float, sigma: float) -> float:
+    r""":math:`J(u^*)`, the exact cost of the exact optimum :func:`optimal_controls` (the
+    denominator of a relative regret)."""
+    kw = {"x0": x0, "a": a, "r": r, "target": target}
+    return exact_cost(optimal_controls(H, **kw), **kw, sigma=sigma)
 
 
 def sample_argmin(
@@ -287,21 +321,72 @@ def expected_regret(n_eff: int | np.ndarray, H: int, *, a: float, r: float, sigm
     return float(out) if np.ndim(out) == 0 else out
 
 
+def weighted_regret_ratio(H: int) -> float:
+    r""":math:`(4/3)^{H/2}/3`, computed as :math:`1/(3 \cdot 0.75^{H/2})`: the first-order mean
+    regret of P likeliness-weighted i.i.d. trajectories over that of P uniformly weighted ones
+    (below 1 for :math:`H \le 7`: the weighting helps)."""
+    H = guards.positive_int("H", H)
+    return 1.0 / (3.0 * 0.75 ** (H / 2))
+
+
+def weighted_expected_regret(P: int, H: int, *, a: float, r: float, sigma: float) -> float:
+    r"""First-order (large P) mean regret of the sample-average argmin over P i.i.d.
+    trajectories with likeliness weights: :math:`\kappa v_H (4/3)^{H/2} / (3P)`, computed as
+    :math:`\kappa v_H / (3 P\, 0.75^{H/2})`."""
+    P = guards.positive_int("P", P)
+    return expected_regret(1, H, a=a, r=r, sigma=sigma) / (3.0 * P * 0.75 ** (H / 2))
+
+
+def regret_standard_error(mean: float, R: int) -> float:
+    r"""Standard error :math:`\rho\sqrt{2/R}` of the mean of ``R`` independent regrets that
+    are each ``mean`` (:math:`\rho`) times a :math:`\chi^2_1` variable (variance
+    :math:`2\rho^2`), as the closed forms :func:`expected_regret` and
+    :func:`weighted_expected_regret` describe."""
+    R = guards.positive_int("R", R)
+    return mean * np.sqrt(2.0 / R)
+
+
 @dataclass(frozen=True)
 class LQGModel:
-    """The oven system as a vectorized :class:`rsmhp.sampling.System` (state dim 1)."""
+    """The oven problem: its constants (a, r, T = ``target``, σ, x_0) and the system as a
+    vectorized :class:`rsmhp.sampling.System` (state dim 1).
+
+    The one definition of the model: experiments build it from the ``lqg.model`` config
+    section (:meth:`from_config`), the closed forms of this module take its
+    :meth:`closed_form_args`. ``x0`` only enters the closed forms (a sampler is given the
+    initial state explicitly); its default 0 is the paper's."""
 
     a: float
     r: float
     target: float
     sigma: float
+    x0: float = 0.0
 
     def __post_init__(self) -> None:
-        _check(a=self.a, sigma=self.sigma, r=self.r, target=self.target)
+        _check(a=self.a, sigma=self.sigma, r=self.r, target=self.target, x0=self.x0)
         if self.sigma == 0:
             raise ValueError("sigma must be > 0 for sampling (the noise density is undefined)")
         # built (and checked, factorised) once: samplers ask for it at every tree and rollout
         object.__setattr__(self, "_noise", GaussianNoise(self.sigma**2))
+
+    @classmethod
+    def from_config(cls, model: Mapping[str, Any], a: float | None = None) -> Self:
+        """From the ``lqg.model`` config section (a, x0, r, target, sigma), every value as a
+        float; ``a`` given here overrides (and makes ``model["a"]`` unnecessary)."""
+        return cls(
+            a=float(model["a"] if a is None else a),
+            r=float(model["r"]),
+            target=float(model["target"]),
+            sigma=float(model["sigma"]),
+            x0=float(model["x0"]),
+        )
+
+    def closed_form_args(self, *, sigma: bool = True) -> dict[str, float]:
+        """Keyword arguments of the closed forms: ``x0, a, r, target`` and, unless
+        ``sigma=False`` (for :func:`nbo_cost`, :func:`optimal_controls`,
+        :func:`sample_argmin`, :func:`regret`, which do not depend on the noise), ``sigma``."""
+        kw = {"x0": self.x0, "a": self.a, "r": self.r, "target": self.target}
+        return {**kw, "sigma": self.sigma} if sigma else kw
 
     @property
     def noise(self) -> GaussianNoise:

@@ -1,4 +1,5 @@
-"""Glue for Snakemake rule scripts: logging to the rule's log file, errors recorded there."""
+"""Glue for Snakemake rule scripts: logging to the rule's log file, errors recorded there, and
+the code stamp of every output (:mod:`rsmhp.code_digest`)."""
 
 from __future__ import annotations
 
@@ -7,17 +8,87 @@ import os
 import sys
 import time
 from collections.abc import Iterator
-from contextlib import contextmanager
+from contextlib import ExitStack, contextmanager
 from pathlib import Path
+from typing import Any
 
 __all__ = ["rule_logging"]
 
+# Expected failures, logged as their message alone: (module, class). Looked up in
+# sys.modules when an exception arrives (a class whose module was never imported cannot have
+# been raised), so that this module imports neither: every rule script imports it, and an
+# import here would make every rule depend on that module's code (rsmhp.code_digest).
+_EXPECTED = (
+    ("rsmhp.io", "IntermediateFileError"),
+    ("rsmhp.config", "ConfigError"),
+    ("rsmhp.verify", "VerificationError"),
+)
+
+
+def _expected() -> tuple[type[BaseException], ...]:
+    found = (getattr(sys.modules.get(m), n, None) for m, n in _EXPECTED)
+    return tuple(c for c in found if isinstance(c, type))
+
+
+def _script_paths(job: Any) -> tuple[Path | None, Path, Path]:
+    """(this job's script, the workflow's scripts directory, the src/ its jobs import from).
+    Snakemake runs a script with ``__file__`` set to its real path."""
+    from rsmhp.code_digest import workflow_src
+
+    scripts = Path(job.scriptdir).resolve()
+    src = workflow_src(scripts)
+    main = getattr(sys.modules.get("__main__"), "__file__", None)
+    script = Path(main).resolve() if main else None
+    if script is None or script.parent != scripts or not script.is_file():
+        script = None
+    return script, scripts, src
+
+
+def _check_code(job: Any, log: logging.Logger) -> str | None:
+    """Refuse a job whose code changed after the workflow was parsed and inputs made by
+    mixed or outdated code (:func:`rsmhp.contracts.check_codes`); return the stamp
+    ``<rule>:<digest>`` its outputs record (None without a ``code`` param)."""
+    from rsmhp.code_digest import code_digest
+    from rsmhp.contracts import check_codes
+    from rsmhp.io import IntermediateFileError
+
+    code = getattr(job.params, "code", None)
+    script, scripts, src = _script_paths(job)
+    if code is not None and script is not None:
+        now = code_digest(script, src)
+        if now != code:
+            raise IntermediateFileError(
+                f"{script.name}: the code of rule {job.rule} changed after the workflow was "
+                f"parsed (digest {code} then, {now} now); nothing was computed: run snakemake "
+                "again, it reruns what the change affects"
+            )
+
+    def current(rule: str) -> str | None:
+        path = scripts / f"{rule}.py"
+        return code_digest(path, src) if path.is_file() else None
+
+    stamps = check_codes(list(job.input), current)
+    if stamps:
+        log.info("inputs made by: %s", ", ".join(sorted(set(stamps.values()))))
+    if code is None:
+        return None
+    log.info("code %s", code)
+    return f"{job.rule}:{code}"
+
 
 @contextmanager
-def rule_logging(log_path: str | os.PathLike, rule: str) -> Iterator[logging.Logger]:
-    """Send ``logging`` (INFO and up) to ``log_path`` and stderr for the duration of a rule script.
+def rule_logging(job: Any, rule: str | None = None) -> Iterator[logging.Logger]:
+    """Send ``logging`` (INFO and up) to the rule's log file and stderr for the duration of a
+    rule script: ``rule_logging(snakemake)`` in a script (or ``rule_logging(log_path, rule)``:
+    logging only).
 
-    An *expected* failure (a corrupt or incomplete intermediate,
+    Given the ``snakemake`` object, before the block runs: the job is refused if its code
+    changed after the workflow was parsed (``params.code`` against the digest of the script's
+    code now), and its inputs are refused if they were made by different or outdated code
+    (:func:`rsmhp.contracts.check_codes`). Within the block every table written through
+    :mod:`rsmhp.io` records ``<rule>:<params.code>``.
+
+    An *expected* failure (a corrupt, incomplete or stale intermediate,
     :class:`rsmhp.io.IntermediateFileError`; an invalid configuration,
     :class:`rsmhp.config.ConfigError`; a run that disagrees with the committed reference,
     :class:`rsmhp.verify.VerificationError`) is logged as its message alone and ends the script with
@@ -26,10 +97,10 @@ def rule_logging(log_path: str | os.PathLike, rule: str) -> Iterator[logging.Log
     way Snakemake marks the job failed (and removes its outputs; they are written atomically,
     so no half-written file is ever left).
     """
-    from rsmhp.config import ConfigError
-    from rsmhp.io import IntermediateFileError
-    from rsmhp.verify import VerificationError
-
+    if isinstance(job, str | os.PathLike):
+        log_path, job = job, None
+    else:
+        log_path, rule = job.log[0], job.rule
     Path(log_path).parent.mkdir(parents=True, exist_ok=True)
     handlers = [
         logging.FileHandler(log_path, mode="w", encoding="utf-8"),
@@ -45,11 +116,16 @@ def rule_logging(log_path: str | os.PathLike, rule: str) -> Iterator[logging.Log
     start = time.perf_counter()
     log.info("start")
     try:
-        yield log
-    except (IntermediateFileError, ConfigError, VerificationError) as exc:
-        log.error("failed: %s", exc)
-        raise SystemExit(1) from None
-    except Exception:
+        with ExitStack() as stack:
+            if job is not None:
+                from rsmhp.io import stamping
+
+                stack.enter_context(stamping(_check_code(job, log)))
+            yield log
+    except Exception as exc:
+        if isinstance(exc, _expected()):
+            log.error("failed: %s", exc)
+            raise SystemExit(1) from None
         log.exception("failed")
         raise
     else:

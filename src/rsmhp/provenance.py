@@ -1,5 +1,6 @@
-"""Provenance of a run: commit, config hash, package versions, BLAS, CPU and its vector flags
-(``results/provenance.json``; the report summarises it)."""
+"""Provenance of a run: commit, config hash, package versions, BLAS, CPU and its vector flags,
+and the digests of the code that made the results (``results/provenance.json``; the report
+summarises it)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,7 @@ from collections.abc import Mapping
 from pathlib import Path
 from typing import Any
 
-__all__ = ["provenance"]
+__all__ = ["code_provenance", "provenance"]
 
 
 def _git(root: Path, *args: str) -> str | None:
@@ -120,3 +121,46 @@ def provenance(
     out["host"] = platform.node()
     out["date (UTC)"] = datetime.datetime.now(datetime.UTC).strftime("%Y-%m-%d %H:%M")
     return out
+
+
+def code_provenance(
+    results: str | os.PathLike,
+    scripts: str | os.PathLike,
+    src: str | os.PathLike | None = None,
+    extra: Mapping[str, tuple[str, list[str]]] | None = None,
+) -> dict[str, Any]:
+    """The code that made the results: for every rule whose tables under ``results`` record a
+    code stamp (:mod:`rsmhp.io`; ``results/paper`` is skipped), the digests recorded with
+    the files that record each (``recorded``), the digest its code gives now (``current``,
+    from ``scripts/<rule>.py`` and ``src``, by default the workflow's) and the modules
+    behind it; ``extra`` adds rules by hand (``{rule: (digest, files)}``, e.g. the report
+    itself). ``modules`` maps every module named to its own digest
+    (:func:`rsmhp.code_digest.describe`)."""
+    from rsmhp.code_digest import DIGEST_LENGTH, describe, workflow_src
+    from rsmhp.io import recorded_code
+
+    results, scripts = Path(results), Path(scripts)
+    src = workflow_src(scripts) if src is None else src
+    recorded: dict[str, dict[str, list[str]]] = {}
+    for path in sorted(results.rglob("*")):
+        rel = path.relative_to(results)
+        if rel.parts[0] == "paper" or path.suffix not in (".csv", ".parquet", ".json"):
+            continue
+        stamp = recorded_code(path)
+        if stamp is not None:
+            rule, _, digest = stamp.rpartition(":")
+            recorded.setdefault(rule, {}).setdefault(digest, []).append(str(path))
+    for rule, (digest, files) in (extra or {}).items():
+        recorded.setdefault(rule, {}).setdefault(digest, []).extend(files)
+    rules: dict[str, Any] = {}
+    modules: dict[str, str] = {}
+    for rule in sorted(recorded):
+        entry: dict[str, Any] = {"recorded": recorded[rule]}
+        script = scripts / f"{rule}.py"
+        if script.is_file():
+            code = describe(script, src)
+            entry["current"] = code.digest
+            entry["modules"] = list(code.modules)
+            modules.update({m: d[:DIGEST_LENGTH] for m, d in code.modules.items()})
+        rules[rule] = entry
+    return {"rules": rules, "modules": dict(sorted(modules.items()))}

@@ -29,8 +29,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from rsmhp import lqg
-from rsmhp.estimators import likeliness_weights
-from rsmhp.experiments.lqg import LQGParams
+from rsmhp.cost_estimators import likeliness_weights
 from rsmhp.palette import method_rgb
 from rsmhp.sampling import sample_tree
 from rsmhp.seeding import canonical_job_id, job_rng
@@ -69,7 +68,7 @@ def tree_blueprint() -> rrb.Blueprint:
     )
 
 
-def _cost_to_go(x: np.ndarray, k: int, u: np.ndarray, params: LQGParams) -> np.ndarray:
+def _cost_to_go(x: np.ndarray, k: int, u: np.ndarray, params: lqg.LQGModel) -> np.ndarray:
     """:math:`\\sum_{j<k}u_j^2 + E[r(x_H-T)^2 + \\sum_{j>=k}u_j^2 | x_k]` for each node."""
     spent = float(np.dot(u[:k], u[:k]))
     if k == len(u):
@@ -80,7 +79,7 @@ def _cost_to_go(x: np.ndarray, k: int, u: np.ndarray, params: LQGParams) -> np.n
 
 def record_lqg_tree(
     path: str | os.PathLike,
-    params: LQGParams,
+    params: lqg.LQGModel,
     u: np.ndarray,
     n_branch: int,
     max_keep: int | None,
@@ -106,9 +105,7 @@ def record_lqg_tree(
         "M": max_keep,
     }
     rng = job_rng(seed, experiment, **job)
-    tree = sample_tree(
-        params.model(), [params.x0], u, n_branch, rng, max_keep=max_keep, keep_history=True
-    )
+    tree = sample_tree(params, [params.x0], u, n_branch, rng, max_keep=max_keep, keep_history=True)
     rec_id = uuid.uuid5(uuid.NAMESPACE_URL, canonical_job_id(experiment, seed=seed, **job))
     rec = rr.RecordingStream("rsmhp_lqg_tree", recording_id=str(rec_id))
     rec.set_log_time_enabled(False)  # only the deterministic `step` timeline
@@ -120,7 +117,7 @@ def record_lqg_tree(
         rec.log(entity, data, static=static)
         rows[entity] = rows.get(entity, 0) + 1
 
-    j_exact = lqg.exact_cost(u, **params.closed())
+    j_exact = lqg.exact_cost(u, **params.closed_form_args())
     j_nbo = lqg.nbo_cost(u, x0=params.x0, a=params.a, r=params.r, target=params.target)
     text = (
         f"# RS-MHP tree, LQG oven problem\n\n"

@@ -72,10 +72,10 @@ def _lqg_cells(config: Mapping[str, Any]) -> dict[str, tuple[int, str]]:
     biggest = 0
     for pt in estimators.grid_points(est, problems):
         prob = problems[pt.problem]
-        leaves = estimators._n_trajectories(pt, prob)
+        leaves = estimators.n_trajectories(pt, prob)
         if pt.scheme in ("tree", "tree_pernode"):
             # replicate trees of row-wise problems are sampled in batches of <= 2^20 leaves
-            batch = estimators._BATCH_LEAVES
+            batch = estimators.BATCH_LEAVES
             per = min(reps, max(1, batch // leaves)) if prob.noise.rowwise else 1
             P = per * leaves
         elif pt.scheme == "pruned":

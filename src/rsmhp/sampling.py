@@ -37,6 +37,8 @@ __all__ = [
     "Trajectories",
     "TreeLevel",
     "TreeSample",
+    "check_controls",
+    "check_initial_state",
     "rollout",
     "rollout_cost",
     "sample_independent",
@@ -183,7 +185,9 @@ class TreeSample:
     history: list[TreeLevel] = field(default_factory=list)
 
 
-def _controls(u: np.ndarray | list[float]) -> np.ndarray:
+def check_controls(u: np.ndarray | list[float]) -> np.ndarray:
+    """The control sequence ``u`` as a finite float array of shape ``(H,)`` or ``(H, m)``,
+    ``H >= 1`` (raises ``ValueError`` otherwise)."""
     u = guards.finite_array("u", u)
     if u.ndim == 0 or u.shape[0] == 0:
         raise ValueError(
@@ -194,8 +198,9 @@ def _controls(u: np.ndarray | list[float]) -> np.ndarray:
     return u
 
 
-def _initial_state(system: System, x0: np.ndarray) -> None:
-    """``x0``: a finite scalar or 1-D state (of the system's dimension ``d`` when it has one)."""
+def check_initial_state(system: System, x0: np.ndarray) -> None:
+    """Raise ``ValueError`` unless ``x0`` is a finite scalar or 1-D state (of the system's
+    dimension ``d`` when it has one)."""
     x = guards.finite_array("x0", x0, ndim=(0, 1), nonempty=True)
     d = getattr(system, "d", None)
     if isinstance(d, int) and x.size != d:
@@ -243,9 +248,9 @@ def rollout(
     Every sampler (plain Monte Carlo, antithetic, quasi-Monte Carlo, quadrature nodes) produces
     noise sequences and calls this; the trajectory costs it returns are then averaged.
     """
-    _initial_state(system, x0)
+    check_initial_state(system, x0)
     noise = np.asarray(noise, dtype=float)
-    states, cost = _propagate(system, x0, _controls(u), noise)
+    states, cost = _propagate(system, x0, check_controls(u), noise)
     loglik = system.noise.logpdf(noise).sum(axis=1)
     return Trajectories(states=states, noise=noise, log_likeliness=loglik, cost=cost)
 
@@ -255,8 +260,8 @@ def rollout_cost(
 ) -> np.ndarray:
     """Only the costs (n,) of :func:`rollout` (same arithmetic), without the likeliness, for
     estimators that do not weight by it."""
-    _initial_state(system, x0)
-    return _propagate(system, x0, _controls(u), np.asarray(noise, dtype=float))[1]
+    check_initial_state(system, x0)
+    return _propagate(system, x0, check_controls(u), np.asarray(noise, dtype=float))[1]
 
 
 def sample_independent(
@@ -266,10 +271,10 @@ def sample_independent(
 
     Noise is drawn as one ``(n, H, dw)`` block from ``rng`` and propagated by :func:`rollout`.
     """
-    u = _controls(u)
+    u = check_controls(u)
     n = guards.positive_int("n (number of trajectories)", n)
     guards.generator("rng", rng)
-    _initial_state(system, x0)
+    check_initial_state(system, x0)
     return rollout(system, x0, u, system.noise.sample(rng, (n, u.shape[0])))
 
 
@@ -300,12 +305,12 @@ def sample_tree(
         level with its own covariance; default ``system.noise`` at every level. The noise
         paths in the result then need a common dimension.
     """
-    u = _controls(u)
+    u = check_controls(u)
     n_branch = guards.positive_int("N (draws per step)", n_branch)
     if max_keep is not None:
         max_keep = guards.positive_int("M (trajectories kept)", max_keep)
     guards.generator("rng", rng)
-    _initial_state(system, x0)
+    check_initial_state(system, x0)
     horizon = u.shape[0]
     if max_keep is None and n_branch**horizon > 20_000_000:
         raise ValueError(
@@ -379,7 +384,7 @@ def sample_tree_batch(
     (tested); otherwise it agrees up to rounding. Leaves are in tree order, as in
     :func:`sample_tree`.
     """
-    u = _controls(u)
+    u = check_controls(u)
     n_branch = guards.positive_int("N (draws per step)", n_branch)
     if max_keep is not None:
         max_keep = guards.positive_int("M (trajectories kept)", max_keep)
@@ -388,7 +393,7 @@ def sample_tree_batch(
         raise ValueError("need at least one generator (one tree per generator)")
     for r, g in enumerate(rngs):
         guards.generator(f"rngs[{r}]", g)
-    _initial_state(system, x0)
+    check_initial_state(system, x0)
     horizon, noise = u.shape[0], system.noise
     n_trees, dw = len(rngs), noise.dim
     x0 = np.atleast_1d(np.asarray(x0, dtype=float))

@@ -1,4 +1,5 @@
 # Shared settings and helpers of every rule file.
+from rsmhp.code_digest import code_digest as _code_digest
 
 THREADS = config["threads"]
 
@@ -11,6 +12,16 @@ ENV = "../envs/rsmhp.yaml"
 REPORT_SECTIONS = {}
 
 REPORT_FIGURES = []
+
+
+def code_digest(script):
+    """The `code` param for `script` (workflow/scripts/<x>.py): the digest of that script
+    and of every rsmhp module under this workflow's src/ it can import (rsmhp.code_digest,
+    content-based, comments and formatting aside). A change to that code changes the param,
+    so Snakemake reruns the job and everything downstream."""
+    return _code_digest(
+        os.path.join(workflow.basedir, script), os.path.join(workflow.basedir, "src")
+    )
 
 
 def canonical(value):

@@ -40,6 +40,7 @@ rule decisions_lqg:
         cfg=canonical(config["decisions"]["lqg"]),
         model=pick(config["lqg"]["model"], "x0", "r", "target", "sigma"),
         seed=config["seed"],
+        code=code_digest("workflow/scripts/decisions_lqg.py"),
     script:
         "../scripts/decisions_lqg.py"
 
@@ -66,6 +67,7 @@ rule decisions_lqg_summary:
     params:
         cfg=canonical(config["decisions"]["lqg"]),
         model=pick(config["lqg"]["model"], "x0", "r", "target", "sigma"),
+        code=code_digest("workflow/scripts/decisions_lqg_summary.py"),
     script:
         "../scripts/decisions_lqg_summary.py"
 
@@ -88,6 +90,7 @@ rule decisions_uav:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         cfg=canonical(DEC["uav"]),
         seed=config["seed"],
+        code=code_digest("workflow/scripts/decisions_uav.py"),
     script:
         "../scripts/decisions_uav.py"
 
@@ -121,6 +124,7 @@ rule decisions_map_cell:
         ),
         scoring=DEC_SCORING,
         seed=config["seed"],
+        code=code_digest("workflow/scripts/decisions_map_cell.py"),
     script:
         "../scripts/decisions_map_cell.py"
 
@@ -151,6 +155,7 @@ rule decisions_uav_summary:
         cfg=canonical(DEC),
         base_limited=config["uav"]["sensor"]["footprint_radius"] is not None,
         seed=config["seed"],
+        code=code_digest("workflow/scripts/decisions_uav_summary.py"),
     script:
         "../scripts/decisions_uav_summary.py"
 
@@ -175,6 +180,7 @@ rule decisions_figures:
         runtime=5,
     params:
         cfg=canonical(DEC["uav"]),
+        code=code_digest("workflow/scripts/decisions_figures.py"),
     script:
         "../scripts/decisions_figures.py"
 
@@ -199,6 +205,7 @@ rule decisions_recording:
         methods=canonical(DEC["uav"]["methods"]),
         recording=canonical(DEC_REC),
         seed=config["seed"],
+        code=code_digest("workflow/scripts/decisions_recording.py"),
     script:
         "../scripts/decisions_recording.py"
 

@@ -52,6 +52,7 @@ rule estimators_ablation:
         estimators=EST_SIM,
         model=canonical(config["lqg"]["model"]),
         seed=config["seed"],
+        code=code_digest("workflow/scripts/estimators_ablation.py"),
     script:
         "../scripts/estimators_ablation.py"
 
@@ -80,6 +81,7 @@ rule estimators_summary:
         ks=config["estimators"]["chebyshev_k"],
         seed=config["seed"],
         estimators=EST_SIM,
+        code=code_digest("workflow/scripts/estimators_summary.py"),
     script:
         "../scripts/estimators_summary.py"
 
@@ -103,6 +105,7 @@ rule estimators_figures:
     params:
         problems=canonical(config["estimators"]["problems"]),
         model=canonical(config["lqg"]["model"]),
+        code=code_digest("workflow/scripts/estimators_figures.py"),
     script:
         "../scripts/estimators_figures.py"
 
@@ -126,6 +129,7 @@ rule estimators_recording:
         recording=canonical(config["estimators"]["recording"]),
         seed=config["seed"],
         experiment="estimators_recording",
+        code=code_digest("workflow/scripts/tree_recording.py"),
     script:
         "../scripts/tree_recording.py"
 

@@ -35,6 +35,7 @@ rule lqg_convergence:
             "convergence": pick(config["lqg"]["convergence"], "u", "P", "replicates"),
         },
         seed=config["seed"],
+        code=code_digest("workflow/scripts/lqg_convergence.py"),
     script:
         "../scripts/lqg_convergence.py"
 
@@ -56,6 +57,7 @@ rule lqg_nbo_error:
     params:
         lqg=pick(config["lqg"], "model", "nbo_error"),
         seed=config["seed"],
+        code=code_digest("workflow/scripts/lqg_nbo_error.py"),
     script:
         "../scripts/lqg_nbo_error.py"
 
@@ -84,6 +86,7 @@ rule lqg_summary:
         eps=config["lqg"]["convergence"]["chebyshev_eps"],
         # the inputs are checked against what the simulations were asked for
         lqg=LQG_SIM,
+        code=code_digest("workflow/scripts/lqg_summary.py"),
     script:
         "../scripts/lqg_summary.py"
 
@@ -109,6 +112,7 @@ rule lqg_figures:
     params:
         eps=config["lqg"]["convergence"]["chebyshev_eps"],
         lqg=LQG_SIM,
+        code=code_digest("workflow/scripts/lqg_figures.py"),
     script:
         "../scripts/lqg_figures.py"
 
@@ -132,6 +136,7 @@ rule lqg_recording:
         recording=canonical(config["lqg"]["recording"]),
         seed=config["seed"],
         experiment="lqg_recording",
+        code=code_digest("workflow/scripts/tree_recording.py"),
     script:
         "../scripts/tree_recording.py"
 

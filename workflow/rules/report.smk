@@ -28,6 +28,7 @@ rule report:
         runtime=5,
     params:
         config=canonical(config),
+        code=code_digest("workflow/scripts/report.py"),
     script:
         "../scripts/report.py"
 
@@ -47,5 +48,7 @@ rule verify:
     resources:
         mem_mb=500,
         runtime=5,
+    params:
+        code=code_digest("workflow/scripts/verify.py"),
     script:
         "../scripts/verify.py"

@@ -53,6 +53,7 @@ rule uav_simulate:
         method=lambda wc: UAV_SPECS[wc.method].spec(),
         runs=lambda wc: chunk_runs(UAV["runs"], len(UAV_CHUNKS), int(wc.chunk)),
         seed=config["seed"],
+        code=code_digest("workflow/scripts/uav_simulate.py"),
     script:
         "../scripts/uav_simulate.py"
 
@@ -91,6 +92,7 @@ rule uav_collect:
         chunks=len(UAV_CHUNKS),
         steps=UAV["scenario"]["steps"],
         seed=config["seed"],
+        code=code_digest("workflow/scripts/uav_collect.py"),
     script:
         "../scripts/uav_collect.py"
 
@@ -120,6 +122,7 @@ rule uav_summary:
         seed=config["seed"],
         methods=UAV_METHODS,
         runs=UAV["runs"],
+        code=code_digest("workflow/scripts/uav_summary.py"),
     script:
         "../scripts/uav_summary.py"
 
@@ -146,6 +149,7 @@ rule uav_figures:
         methods=UAV_METHODS,
         runs=UAV["runs"],
         seed=config["seed"],
+        code=code_digest("workflow/scripts/uav_figures.py"),
     script:
         "../scripts/uav_figures.py"
 
@@ -169,6 +173,7 @@ rule uav_recording:
         methods=[s.spec() for s in UAV_SPECS.values()],
         max_hypotheses=UAV["recording"]["max_hypotheses"],
         seed=config["seed"],
+        code=code_digest("workflow/scripts/uav_recording.py"),
     script:
         "../scripts/uav_recording.py"
 

@@ -2,7 +2,8 @@
 
 from pathlib import Path
 
-from rsmhp.analysis.decisions import LQG_SUMMARY_COLUMNS, MAP_COLUMNS
+from rsmhp.analysis.decisions_lqg import LQG_SUMMARY_COLUMNS
+from rsmhp.analysis.decisions_uav import MAP_COLUMNS
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.decisions_uav import regret_contract
 from rsmhp.figures import decisions as figs
@@ -10,7 +11,7 @@ from rsmhp.figures import save_figure
 from rsmhp.io import read_table
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent
     summary = read_table(snakemake.input.lqg, LQG_SUMMARY_COLUMNS)
     save_figure(figs.lqg_regret_figure(summary), outdir / "dec_lqg_regret")

@@ -4,7 +4,7 @@ from rsmhp.experiments.decisions_uav import run_map_cell
 from rsmhp.io import write_csv
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     runs, regret = run_map_cell(
         snakemake.params.uav,
         snakemake.params.cfg,

@@ -5,7 +5,7 @@ from rsmhp.experiments.decisions_uav import recording_setup
 from rsmhp.pipeline import rule_logging
 from rsmhp.uav.recording import record_uav_run
 
-with rule_logging(snakemake.log[0], snakemake.rule) as log:
+with rule_logging(snakemake) as log:
     rec = snakemake.params.recording
     setup, methods = recording_setup(
         snakemake.params.uav, snakemake.params.models, snakemake.params.methods, rec["model"]

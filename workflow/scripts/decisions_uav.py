@@ -4,7 +4,7 @@ from rsmhp.experiments.decisions_uav import run_uav_regret
 from rsmhp.io import write_csv
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     df = run_uav_regret(
         snakemake.params.uav, snakemake.params.cfg, snakemake.params.seed, snakemake.threads
     )

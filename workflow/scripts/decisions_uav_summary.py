@@ -4,13 +4,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.analysis import decisions as analysis
+from rsmhp.analysis import decisions_uav as analysis
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.decisions_uav import map_contracts, regret_contract
 from rsmhp.io import write_csv, write_text
+from rsmhp.narrative import decisions_uav as narrative
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     cfg, seed = snakemake.params.cfg, snakemake.params.seed
     n_boot = int(cfg["map"]["bootstrap"])
     regret = read_checked(snakemake.input.regret, regret_contract(cfg["uav"]))
@@ -32,11 +33,11 @@ with rule_logging(snakemake.log[0], snakemake.rule):
     groups = analysis.summarize_map_groups(
         map_runs, map_df, seed, n_boot, snakemake.params.base_limited
     )
-    tables = analysis.uav_tables(summary, map_df)
+    tables = narrative.uav_tables(summary, map_df)
     write_csv(summary, snakemake.output.regret_summary)
     write_csv(map_df, snakemake.output.map)
     write_csv(groups, snakemake.output.map_groups)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
-    section = analysis.uav_decision_section(regret, summary, map_df, groups, tables, cfg, seed)
+    section = narrative.uav_decision_section(regret, summary, map_df, groups, tables, cfg, seed)
     section.save(snakemake.output.section)

@@ -4,7 +4,7 @@ from rsmhp.experiments.estimators import run_ablation
 from rsmhp.io import write_csv
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     df = run_ablation(
         snakemake.params.estimators,
         snakemake.params.model,

@@ -6,9 +6,10 @@ from rsmhp.analysis import estimators as analysis
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.estimators import ablation_contract
 from rsmhp.io import write_csv, write_text
+from rsmhp.narrative import estimators as narrative
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     ks = list(snakemake.params.ks)
     contract = ablation_contract(snakemake.params.estimators, snakemake.params.model)
     df = read_checked(snakemake.input.ablation, contract)
@@ -16,8 +17,8 @@ with rule_logging(snakemake.log[0], snakemake.rule):
         {"problems": snakemake.params.problems}, snakemake.params.model
     )
     summary = analysis.summarize_ablation(df, problems, snakemake.params.seed)
-    tables = analysis.tables(df, summary, ks)
+    tables = narrative.tables(df, summary, ks)
     write_csv(summary, snakemake.output.summary)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
-    analysis.estimators_section(df, summary, ks, tables).save(snakemake.output.section)
+    narrative.estimators_section(df, summary, ks, tables).save(snakemake.output.section)

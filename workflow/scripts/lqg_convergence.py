@@ -4,6 +4,6 @@ from rsmhp.experiments.lqg import run_convergence
 from rsmhp.io import write_csv
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     df = run_convergence(snakemake.params.lqg, snakemake.params.seed, n_jobs=snakemake.threads)
     write_csv(df, snakemake.output[0])

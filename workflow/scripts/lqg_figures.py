@@ -11,7 +11,7 @@ from rsmhp.figures import save_figure
 from rsmhp.io import read_table
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     eps = list(snakemake.params.eps)
     conv = read_checked(snakemake.input.convergence, convergence_contract(snakemake.params.lqg))
     per_eps = [

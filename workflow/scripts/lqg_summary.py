@@ -6,18 +6,19 @@ from rsmhp.analysis import lqg as analysis
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.lqg import convergence_contract, nbo_error_contract
 from rsmhp.io import write_csv, write_text
+from rsmhp.narrative import lqg as narrative
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     eps = list(snakemake.params.eps)
     sim = snakemake.params.lqg
     conv = read_checked(snakemake.input.convergence, convergence_contract(sim))
     nbo = read_checked(snakemake.input.nbo_error, nbo_error_contract(sim))
     summary = analysis.summarize_convergence(conv, eps)
     nbo_summary = analysis.summarize_nbo_error(nbo)
-    tables = analysis.lqg_tables(summary, nbo_summary, eps)
+    tables = narrative.lqg_tables(summary, nbo_summary, eps)
     write_csv(summary, snakemake.output.summary)
     write_csv(nbo_summary, snakemake.output.nbo_summary)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
-    analysis.lqg_section(summary, nbo_summary, conv, eps, tables).save(snakemake.output.section)
+    narrative.lqg_section(summary, nbo_summary, conv, eps, tables).save(snakemake.output.section)

@@ -1,6 +1,6 @@
 """Rule report: render results/paper/replication.md (main text) and appendix.md from the
 report sections, copy their figures, write the claims (claims.json, the README's glance
-table) and results/provenance.json."""
+table) and results/provenance.json (with the digests of the code that made the results)."""
 
 import json
 import shutil
@@ -9,18 +9,27 @@ from pathlib import Path
 from rsmhp.io import write_text
 from rsmhp.ledger import Section, claims_records
 from rsmhp.pipeline import rule_logging
-from rsmhp.provenance import provenance
+from rsmhp.provenance import code_provenance, provenance
 from rsmhp.report import glance_table, render_appendix, render_report
 
-with rule_logging(snakemake.log[0], snakemake.rule) as log:
+with rule_logging(snakemake) as log:
     sections = [Section.load(p) for p in snakemake.input.sections]
     for src, dst in zip(snakemake.input.figures, snakemake.output.figures, strict=True):
         Path(dst).parent.mkdir(parents=True, exist_ok=True)
         shutil.copyfile(src, dst)
     prov = provenance(snakemake.params.config)
+    prov["code"] = code_provenance(
+        Path(snakemake.output.provenance).parent,
+        snakemake.scriptdir,
+        extra={snakemake.rule: (snakemake.params.code, [snakemake.output.provenance])},
+    )
     write_text(json.dumps(prov, indent=1) + "\n", snakemake.output.provenance)
-    # the report summarises it; host and date stay in the JSON (they change every run)
-    summary = {k: v for k, v in prov.items() if k not in ("host", "date (UTC)")}
+    # the report summarises it; host and date stay in the JSON (they change every run), the
+    # code as one digest per rule
+    summary = {k: v for k, v in prov.items() if k not in ("host", "date (UTC)", "code")}
+    summary["code (rule digest)"] = ", ".join(
+        f"{rule} {' / '.join(e['recorded'])}" for rule, e in prov["code"]["rules"].items()
+    )
     main = render_report(sections, summary)
     write_text(main, snakemake.output.report)
     write_text(

@@ -10,7 +10,7 @@ from rsmhp.experiments.uav import STEP_COLUMNS, chunk_contracts, chunk_runs, run
 from rsmhp.io import write_csv, write_parquet
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule) as log:
+with rule_logging(snakemake) as log:
     p = snakemake.params
     order = {m: i for i, m in enumerate(p.methods)}
 

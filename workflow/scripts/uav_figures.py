@@ -3,15 +3,15 @@ error) and, for each, the paired view (per-run differences, mean and CI) (PNG + 
 
 from pathlib import Path
 
-from rsmhp.analysis.uav import FIGURES
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.uav import runs_contract
 from rsmhp.figures import save_figure
 from rsmhp.figures import uav as figs
 from rsmhp.io import read_table
+from rsmhp.narrative.uav import FIGURES
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     p = snakemake.params
     runs = read_checked(snakemake.input.runs, runs_contract(p.methods, p.runs, p.seed))
     summary = read_table(snakemake.input.summary, ["method", "family", "label", "N_T", "n_runs"])

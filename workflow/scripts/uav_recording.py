@@ -5,7 +5,7 @@ from rsmhp.uav import methods
 from rsmhp.uav.recording import record_uav_run
 from rsmhp.uav.simulation import UAVSetup
 
-with rule_logging(snakemake.log[0], snakemake.rule) as log:
+with rule_logging(snakemake) as log:
     rows, _ = record_uav_run(
         snakemake.output[0],
         UAVSetup.from_config(snakemake.params.uav),

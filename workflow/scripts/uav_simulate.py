@@ -4,7 +4,7 @@ from rsmhp.experiments.uav import run_chunk
 from rsmhp.io import write_csv, write_parquet
 from rsmhp.pipeline import rule_logging
 
-with rule_logging(snakemake.log[0], snakemake.rule):
+with rule_logging(snakemake):
     runs, steps = run_chunk(
         snakemake.params.uav,
         snakemake.params.method,

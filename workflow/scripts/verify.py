@@ -5,7 +5,7 @@ from pathlib import Path
 from rsmhp.pipeline import rule_logging
 from rsmhp.verify import VerificationError, verify
 
-with rule_logging(snakemake.log[0], snakemake.rule) as log:
+with rule_logging(snakemake) as log:
     try:
         ok, text = verify(snakemake.input.reference, snakemake.input.run)
     except ValueError as exc:

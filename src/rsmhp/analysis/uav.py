@@ -1,4 +1,6 @@
-r"""Aggregation of the UAV Monte-Carlo study: per-method summaries, paired differences, claims.
+r"""UAV Monte-Carlo study, statistics: per-method summaries, paired differences and the ranges
+of the figures. Numbers only: the claims UAV-1..3 are in :mod:`rsmhp.claims.uav`, the prose
+and tables in :mod:`rsmhp.narrative.uav`.
 
 Metric: for run :math:`r` and method :math:`A`, the paper's average target location error
 :math:`e_r(A) = \frac1K \sum_{k=1}^K \|\hat p_k - p_k\|` (metres; ``mean_error``, estimate
@@ -14,89 +16,95 @@ Statistics:
   the two-sided Wilcoxon signed-rank p-value (``scipy.stats.wilcoxon``; undefined when every
   :math:`d_r = 0`).
 
+Methods come from the registry (:mod:`rsmhp.uav.methods`): tables list them in its order
+(:meth:`~rsmhp.uav.methods.Method.sort_key`) and every method is compared with the baseline
+family's member (purpose :func:`vs_baseline`). Two more kinds of pairs serve the paper's
+claims about specific families: the N_T trend of RS-MHP (:class:`MonteCarlo`; consecutive
+N_T and largest vs smallest) and each pruned tree (:class:`PrunedTree`) vs RS-MHP with
+N_T = M.
+
 Bootstrap resamples come from ``job_rng(seed, "uav_bootstrap", statistic=..., method=...,
 baseline=...)``: the same inputs give the same intervals.
-
-Verdict rule (stated once, applied mechanically by :func:`verdict`)
--------------------------------------------------------------------
-For a claim "A has lower error than B" with :math:`d_r = e_r(A) - e_r(B)` and the 95%
-bootstrap CI :math:`[l, h]` of :math:`\bar d`: *supported* if :math:`h < 0` (the CI lies
-entirely below 0), *not supported* if :math:`l > 0` (entirely above 0), *inconclusive*
-otherwise, i.e. when the CI contains or touches 0 (no detectable difference at this number of
-runs; the CI says how large a difference is still compatible with the data).
-
-* **UAV-1** (Fig. 4: error falls as N_T grows): A = RS-MHP with the largest N_T, B = RS-MHP
-  with the smallest N_T (consecutive N_T pairs are reported alongside, not used in the verdict).
-* **UAV-2** (Fig. 5: RS-MHP beats NBO): A = RS-MHP with the largest N_T, B = NBO (the other
-  N_T and the pruned tree are reported alongside).
-* **UAV-3** (Sec. III-B remark: pruning degrades RS-MHP): A = RS-MHP with N_T = M
-  (non-overlapping), B = the pruned tree keeping M trajectories; only if both were run.
 
 Figure ranges (:func:`robust_range`): an axis showing n pooled values ends 10% (of the
 distance between them) beyond their 1st and 99th percentiles taken as order statistics
 (:math:`x_{(k)}` and :math:`x_{(n-1-k)}`, :math:`k = \lfloor n/100 \rfloor`), never beyond the
 data: at most k values at each end are left out, none when n < 100. The figures and captions
-count the values left out.
+count the values left out (:func:`clip_note`).
 """
 
 from __future__ import annotations
 
 import itertools
 from collections.abc import Mapping, Sequence
-from typing import Any
 
 import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
-from rsmhp.ledger import Claim, KeyNumber, Section
-from rsmhp.markdown import fmt, fmt_ci, markdown_table
+from rsmhp.markdown import fmt
 from rsmhp.palette import method_label
 from rsmhp.seeding import job_rng
 from rsmhp.stats import bootstrap_ci
+from rsmhp.uav import methods as registry
+from rsmhp.uav.methods.base import Method
+from rsmhp.uav.methods.monte_carlo import MonteCarlo
+from rsmhp.uav.methods.pruned_tree import PrunedTree
 
 __all__ = [
-    "FIGURES",
+    "PRUNING",
+    "TREND",
+    "baseline_name",
     "cdf_methods",
     "cdf_range",
     "clip_note",
     "comparison_pairs",
+    "family_rows",
     "figure_notes",
-    "key_comparisons",
+    "is_family",
+    "method_table",
     "paired_differences",
     "paired_range",
     "paired_view",
     "per_run_differences",
     "robust_range",
     "summarize_methods",
-    "uav_claims",
-    "uav_section",
-    "uav_tables",
-    "verdict",
+    "vs_baseline",
 ]
 
-#: figure stems written by the figure rule and referenced by the report section, in the order
-#: of the section: each paper-style CDF is followed by its paired view
-FIGURES = ("uav_error_cdf_nt", "uav_paired_diff_nt", "uav_error_cdf_nbo", "uav_paired_diff")
+#: ``purpose`` of the pairs of RS-MHP's N_T trend (UAV-1) and of the pruning pairs (UAV-3)
+TREND = "N_T trend"
+PRUNING = "pruning"
 
 
-def verdict(ci_low: float, ci_high: float) -> str:
-    """The module's rule for "A has lower error than B" from the CI ``[l, h]`` of the mean of
-    ``d = e(A) - e(B)``: ``h < 0`` supported, ``l > 0`` not supported, else (CI contains or
-    touches 0) inconclusive."""
-    if ci_high < 0.0:
-        return "supported"
-    if ci_low > 0.0:
-        return "not supported"
-    return "inconclusive"
+def vs_baseline() -> str:
+    """``purpose`` of the pairs "every method vs the baseline" (``"vs NBO"``)."""
+    return f"vs {registry.baseline().family_label}"
 
 
-def _methods(runs: pd.DataFrame) -> pd.DataFrame:
-    """One row per method (method, family, N_T, N, M), NBO first, then RS-MHP by N_T, trees."""
+def baseline_name() -> str:
+    """Name of the baseline family's member (``"nbo"``), the B of every "vs" comparison."""
+    return registry.baseline()().name
+
+
+def is_family(names: pd.Series, family: type[Method]) -> pd.Series:
+    """Boolean mask (same index as ``names``, a column of method names): which belong to
+    ``family``."""
+    return names.map(lambda m: registry.from_name(str(m)).family == family.family).astype(bool)
+
+
+def family_rows(table: pd.DataFrame, family: type[Method]) -> pd.DataFrame:
+    """Rows of ``table`` (a ``method`` and an ``N_T`` column) of ``family``, by N_T (ties in
+    table order)."""
+    return table.loc[is_family(table["method"], family)].sort_values("N_T", kind="stable")
+
+
+def method_table(runs: pd.DataFrame) -> pd.DataFrame:
+    """One row per method (method, family, N_T, N, M), in the registry's order."""
     meta = runs[["method", "family", "N_T", "N", "M"]].drop_duplicates("method")
-    order = {"nbo": 0, "rsmhp": 1, "tree": 2}
-    meta = meta.assign(_o=meta["family"].map(order))
-    return meta.sort_values(["_o", "N_T", "N", "M"]).drop(columns="_o").reset_index(drop=True)
+    key = {m: registry.from_name(m).sort_key() for m in meta["method"]}
+    order = sorted(meta["method"], key=key.__getitem__)
+    return meta.set_index("method").loc[order].reset_index()
 
 
 def summarize_methods(
@@ -105,7 +113,7 @@ def summarize_methods(
     """Per method: runs, mean, median and SD of ``mean_error`` (with bootstrap CIs of mean and
     median), mean RMSE and tr P, planner wall time per run (seconds; not deterministic)."""
     rows = []
-    for _, meta in _methods(runs).iterrows():
+    for _, meta in method_table(runs).iterrows():
         grp = runs[runs["method"] == meta["method"]]
         err = grp["mean_error"].to_numpy()
         rng = job_rng(seed, "uav_bootstrap", statistic="per_method", method=meta["method"])
@@ -132,22 +140,42 @@ def summarize_methods(
 
 
 def comparison_pairs(runs: pd.DataFrame) -> list[tuple[str, str, str]]:
-    """(method, baseline, purpose) pairs: every method vs NBO, RS-MHP N_T trend (consecutive
-    and largest vs smallest), and each pruned tree vs RS-MHP with N_T = M."""
-    meta = _methods(runs)
-    pairs = []
+    """(method, baseline, purpose) pairs: every method vs the baseline (if it was run), RS-MHP's
+    N_T trend (consecutive and largest vs smallest), each pruned tree vs RS-MHP with N_T = M."""
+    meta = method_table(runs)
     names = meta["method"].tolist()
-    if "nbo" in names:
-        pairs += [(m, "nbo", "vs NBO") for m in names if m != "nbo"]
-    rs = meta[meta["family"] == "rsmhp"].sort_values("N_T")["method"].tolist()
-    pairs += [(b, a, "N_T trend") for a, b in itertools.pairwise(rs)]
+    base = baseline_name()
+    pairs = [(m, base, vs_baseline()) for m in names if m != base] if base in names else []
+    rs = family_rows(meta, MonteCarlo)["method"].tolist()
+    pairs += [(b, a, TREND) for a, b in itertools.pairwise(rs)]
     if len(rs) > 2:
-        pairs.append((rs[-1], rs[0], "N_T trend"))
-    for _, t in meta[meta["family"] == "tree"].iterrows():
-        twin = meta[(meta["family"] == "rsmhp") & (meta["N_T"] == t["M"])]
+        pairs.append((rs[-1], rs[0], TREND))
+    mc = meta.loc[is_family(meta["method"], MonteCarlo)]
+    for _, t in meta.loc[is_family(meta["method"], PrunedTree)].iterrows():
+        twin = mc[mc["N_T"] == t["M"]]
         if len(twin):
-            pairs.append((twin["method"].iloc[0], t["method"], "pruning"))
+            pairs.append((twin["method"].iloc[0], t["method"], PRUNING))
     return pairs
+
+
+def _paired_row(
+    d: np.ndarray, n_missing: int, rng: np.random.Generator, n_boot: int, level: float
+) -> dict[str, float | int]:
+    """The statistics of one paired comparison's differences ``d`` (columns of
+    :func:`paired_differences` after ``purpose``)."""
+    lo, hi = bootstrap_ci(d, rng, n_boot, level)
+    return {
+        "n_runs": d.size,
+        "n_missing": n_missing,
+        "mean_diff": float(d.mean()),
+        "ci_low": lo,
+        "ci_high": hi,
+        "median_diff": float(np.median(d)),
+        "sd_diff": float(d.std(ddof=1)) if d.size > 1 else 0.0,
+        "n_better": int(np.sum(d < 0)),
+        "frac_better": float(np.mean(d < 0)),
+        "wilcoxon_p": float(sps.wilcoxon(d).pvalue) if np.any(d != 0) else float("nan"),
+    }
 
 
 def paired_differences(
@@ -162,24 +190,13 @@ def paired_differences(
         pair = wide[[method, base]].dropna()
         d = (pair[method] - pair[base]).to_numpy()
         rng = job_rng(seed, "uav_bootstrap", statistic="paired", method=method, baseline=base)
-        lo, hi = bootstrap_ci(d, rng, n_boot, level)
-        p = float(sps.wilcoxon(d).pvalue) if np.any(d != 0) else float("nan")
         rows.append(
             {
                 "method": method,
                 "baseline": base,
                 "comparison": f"{method_label(method)} − {method_label(base)}",
                 "purpose": purpose,
-                "n_runs": d.size,
-                "n_missing": int(len(wide) - d.size),
-                "mean_diff": float(d.mean()),
-                "ci_low": lo,
-                "ci_high": hi,
-                "median_diff": float(np.median(d)),
-                "sd_diff": float(d.std(ddof=1)) if d.size > 1 else 0.0,
-                "n_better": int(np.sum(d < 0)),
-                "frac_better": float(np.mean(d < 0)),
-                "wilcoxon_p": p,
+                **_paired_row(d, int(len(wide) - d.size), rng, n_boot, level),
             }
         )
     return pd.DataFrame(rows)
@@ -207,7 +224,8 @@ def robust_range(values: Sequence[float] | np.ndarray, q: float = 0.01, widen: f
 def clip_note(groups: Mapping[str, np.ndarray], lo: float, hi: float, what: str = "runs") -> str:
     """Sentence saying which values of ``groups`` (label -> values, metres) lie outside
     ``[lo, hi]`` and so are not shown; empty when none. Equal counts beyond ``hi`` in every
-    group give ``"1 run per curve beyond 19.3 m not shown (up to 29.9 m)"``."""
+    group give ``"1 run per curve beyond 19.3 m not shown (up to 29.9 m)"``. Shared by the
+    figures and the section's captions, so both count the same values."""
     allv = np.concatenate([np.asarray(v, dtype=float) for v in groups.values()])
     below = {k: int(np.sum(np.asarray(v) < lo)) for k, v in groups.items()}
     above = {k: int(np.sum(np.asarray(v) > hi)) for k, v in groups.items()}
@@ -227,16 +245,17 @@ def clip_note(groups: Mapping[str, np.ndarray], lo: float, hi: float, what: str 
 
 def cdf_methods(summary: pd.DataFrame) -> dict[str, list[str]]:
     """Methods of the paper-style CDFs: ``"nt"`` (Fig. 4) every RS-MHP by N_T; ``"nbo"``
-    (Fig. 5) NBO and RS-MHP with the largest N_T (the comparison of UAV-2)."""
-    rs = summary[summary["family"] == "rsmhp"].sort_values("N_T")["method"].tolist()
-    nbo = ["nbo"] if "nbo" in set(summary["method"]) else []
-    return {"nt": rs, "nbo": nbo + rs[-1:]}
+    (Fig. 5) the baseline and RS-MHP with the largest N_T (the comparison of UAV-2)."""
+    rs = family_rows(summary, MonteCarlo)["method"].tolist()
+    base = [baseline_name()] if baseline_name() in set(summary["method"]) else []
+    return {"nt": rs, "nbo": base + rs[-1:]}
 
 
 def paired_view(paired: pd.DataFrame, view: str) -> pd.DataFrame:
     """Rows of ``paired`` drawn in a paired figure: ``"nt"`` the N_T trend and pruning pairs
-    (Fig. 4 side, UAV-1 and UAV-3), ``"nbo"`` every method minus NBO (Fig. 5 side, UAV-2)."""
-    purposes = {"nt": ("N_T trend", "pruning"), "nbo": ("vs NBO",)}[view]
+    (Fig. 4 side, UAV-1 and UAV-3), ``"nbo"`` every method minus the baseline (Fig. 5 side,
+    UAV-2)."""
+    purposes = {"nt": (TREND, PRUNING), "nbo": (vs_baseline(),)}[view]
     return paired[paired["purpose"].isin(purposes)].reset_index(drop=True)
 
 
@@ -283,370 +302,3 @@ def figure_notes(
         if len(rows):
             out[stem] = paired_range(runs, rows)
     return out
-
-
-def key_comparisons(summary: pd.DataFrame, paired: pd.DataFrame) -> dict[str, tuple[str, str]]:
-    """Claim id -> (A, B), the comparison whose mean paired difference is the claim's key
-    number (module doc); claims whose methods were not run are absent."""
-    rs = summary[summary["family"] == "rsmhp"].sort_values("N_T")["method"].tolist()
-    have = set(zip(paired["method"], paired["baseline"], strict=True))
-    out = {}
-    if len(rs) >= 2 and (rs[-1], rs[0]) in have:
-        out["UAV-1"] = (rs[-1], rs[0])
-    if rs and (rs[-1], "nbo") in have:
-        out["UAV-2"] = (rs[-1], "nbo")
-    prune = paired[paired["purpose"] == "pruning"]
-    if len(prune):
-        out["UAV-3"] = (prune["method"].iloc[0], prune["baseline"].iloc[0])
-    return out
-
-
-# ---------------------------------------------------------------------------- claims
-
-
-_RULE = (
-    "d_r = e_r({a}) − e_r({b}), e_r = run r's average target location error (m); supported if "
-    "the 95% bootstrap CI of mean d lies entirely below 0, not supported if entirely above 0, "
-    "inconclusive if it contains or touches 0"
-)
-
-
-def _short(method: str) -> str:
-    """``N_T=250``, ``NBO``, ``tree N=8 M=100``: short names for key-number labels."""
-    return method_label(method).replace("RS-MHP ", "").replace("pruned tree", "tree")
-
-
-def _stats(row: pd.Series) -> str:
-    """Secondary numbers of one paired comparison (measured text)."""
-    p = row["wilcoxon_p"]
-    ptxt = f"Wilcoxon p = {fmt(p, 2)}" if np.isfinite(p) else "Wilcoxon p undefined (all d = 0)"
-    return (
-        f"{row['comparison']}: mean d {fmt(row['mean_diff'], 2, True)} "
-        f"{fmt_ci(row['ci_low'], row['ci_high'], 2, True)} m, median d "
-        f"{fmt(row['median_diff'], 2, True)} m, d < 0 in {int(row['n_better'])} of "
-        f"{int(row['n_runs'])} runs, {ptxt}"
-    )
-
-
-def _alongside(rows: pd.DataFrame) -> str:
-    return "; ".join(
-        f"{r['comparison']}: {fmt(r['mean_diff'], 2, True)} "
-        f"{fmt_ci(r['ci_low'], r['ci_high'], 2, True)} m"
-        for _, r in rows.iterrows()
-    )
-
-
-def _dropped(row: pd.Series) -> str:
-    """Runs left out of a paired comparison (a method without a result for them)."""
-    n = int(row.get("n_missing", 0))
-    return f"{n} run(s) without a result for both methods" if n else ""
-
-
-def _claim(
-    cid: str, claim: str, paper: str, row: pd.Series, measured: str, dropped: str = ""
-) -> Claim:
-    a, b = _short(row["method"]), _short(row["baseline"])
-    key = KeyNumber(
-        name=f"mean d, e({a}) − e({b})",
-        value=float(row["mean_diff"]),
-        ci_low=float(row["ci_low"]),
-        ci_high=float(row["ci_high"]),
-        unit="m",
-        reproducible="statistical",
-        digits=2,
-        null=0.0,
-    )
-    drop = "; ".join(x for x in (dropped, _dropped(row)) if x)
-    return Claim(
-        id=cid,
-        claim=claim,
-        paper=paper,
-        key=key,
-        verdict=verdict(row["ci_low"], row["ci_high"]),
-        rule=_RULE.format(a=a, b=b),
-        measured=measured,
-        dropped=drop,
-    )
-
-
-def uav_claims(summary: pd.DataFrame, paired: pd.DataFrame) -> list[Claim]:
-    """Claims UAV-1..3 by the module's verdict rule (those whose methods were run)."""
-    claims = []
-    keys = key_comparisons(summary, paired)
-
-    def pick(cid: str) -> tuple[pd.Series, pd.Series]:
-        a, b = keys[cid]
-        is_key = (paired["method"] == a) & (paired["baseline"] == b)
-        return paired[is_key].iloc[0], is_key
-
-    rs = summary[summary["family"] == "rsmhp"].sort_values("N_T")
-    if "UAV-1" in keys:
-        main, is_key = pick("UAV-1")
-        trend = (paired["purpose"] == "N_T trend") & ~is_key
-        means = ", ".join(f"{r['label']} {fmt(r['mean'], 4)} m" for _, r in rs.iterrows())
-        measured = f"{_stats(main)}; mean e: {means}"
-        if trend.any():
-            measured += f"; consecutive N_T (mean d, CI): {_alongside(paired[trend])}"
-        nts = ", ".join(str(int(n)) for n in rs["N_T"])
-        claims.append(
-            _claim(
-                "UAV-1",
-                f"Average target location error falls as N_T grows (N_T = {nts})",
-                "Sec. III-B, Fig. 4: CDFs of the average location error improve gradually with "
-                "N_T = 50, 100, 250 (H = 6)",
-                main,
-                measured,
-            )
-        )
-    if "UAV-2" in keys:
-        main, is_key = pick("UAV-2")
-        others = (paired["purpose"] == "vs NBO") & ~is_key
-        measured = _stats(main)
-        if others.any():
-            measured += f"; other methods − NBO (mean d, CI): {_alongside(paired[others])}"
-        claims.append(
-            _claim(
-                "UAV-2",
-                f"RS-MHP ({_short(main['method'])}) gives lower target location error than NBO",
-                "Sec. III-B, Fig. 5: CDF of the average location error, RS-MHP better than NBO",
-                main,
-                measured,
-            )
-        )
-    if "UAV-3" in keys:
-        main, is_key = pick("UAV-3")
-        others = paired[(paired["purpose"] == "pruning") & ~is_key]
-        claims.append(
-            _claim(
-                "UAV-3",
-                "Pruning degrades RS-MHP: non-overlapping N_T = M beats the pruned tree keeping "
-                "M trajectories",
-                "Sec. III-B, text after Fig. 4: the N_T trend suggests pruning would degrade "
-                "RS-MHP (no experiment shown)",
-                main,
-                _stats(main),
-                dropped=(
-                    "further pruned trees, reported but not the key number (the first one is): "
-                    + _alongside(others)
-                    if len(others)
-                    else ""
-                ),
-            )
-        )
-    return claims
-
-
-# ---------------------------------------------------------------------------- tables, section
-
-
-def uav_tables(summary: pd.DataFrame, paired: pd.DataFrame) -> dict[str, str]:
-    """Markdown tables keyed by file stem (``results/tables/<stem>.md``): per method, and the
-    paired comparisons (a Wilcoxon p that is undefined prints as ``n/a``, explained below)."""
-    methods = pd.DataFrame(
-        {
-            "method": summary["label"],
-            "runs": summary["n_runs"].astype(int),
-            "mean e (m)": summary["mean"],
-            "CI low": summary["ci_low"],
-            "CI high": summary["ci_high"],
-            "median e (m)": summary["median"],
-            "median CI low": summary["median_low"],
-            "median CI high": summary["median_high"],
-            "SD of e (m)": summary["sd"],
-            "RMSE (m)": summary["mean_rmse"],
-            "mean tr P̂": summary["mean_trace"],
-            "planner s/run": summary["plan_seconds_per_run"],
-        }
-    )
-    pairs = pd.DataFrame(
-        {
-            "comparison A − B": paired["comparison"],
-            "purpose": paired["purpose"],
-            "runs": paired["n_runs"].astype(int),
-            "mean d (m)": paired["mean_diff"],
-            "CI low": paired["ci_low"],
-            "CI high": paired["ci_high"],
-            "median d (m)": paired["median_diff"],
-            "SD of d (m)": paired["sd_diff"],
-            "runs d < 0": paired["n_better"].astype(int),
-            "Wilcoxon p": paired["wilcoxon_p"],
-        }
-    )
-    signed = ("mean d (m)", "CI low", "CI high", "median d (m)")
-    ptable = markdown_table(pairs, digits=3, missing="n/a", signed=signed)
-    if paired["wilcoxon_p"].isna().any():
-        ptable += "\n\nn/a: every paired difference is 0, the signed-rank test is undefined."
-    return {"uav_methods": markdown_table(methods, digits=4), "uav_paired": ptable}
-
-
-def _num(x: float) -> str:
-    """A configuration number as given: integer-valued numbers without decimals (``1``, not
-    ``1.00``), others with at most 3 significant digits and no trailing zeros."""
-    xf = float(x)
-    if xf.is_integer():
-        return fmt(int(xf))
-    out = fmt(xf)
-    return out if "e" in out else out.rstrip("0").rstrip(".")
-
-
-def _variant_note(sensor: Mapping[str, Any]) -> str:
-    """A sentence naming the model variant when the sensor is not the reconstruction's."""
-    parts = []
-    if sensor.get("footprint_radius") is not None:
-        parts.append(
-            f"a sensor footprint of radius {_num(sensor['footprint_radius'])} m (truth detections "
-            f"{sensor.get('detection', 'hard')}, planner width "
-            f"{_num(sensor.get('footprint_width', 10))} m)"
-        )
-    if sensor.get("noise_growth", "linear") != "linear":
-        parts.append(
-            f"noise growing quadratically with distance (reference "
-            f"{_num(sensor.get('reference_distance', 100))} m)"
-        )
-    if not parts:
-        return ""
-    return " **Model variant, not the paper's model:** " + "; ".join(parts) + "."
-
-
-def _caption(text: str, note: str) -> str:
-    return f"*{text}{'; ' + note if note else ''}.*"
-
-
-def uav_section(
-    summary: pd.DataFrame,
-    paired: pd.DataFrame,
-    tables: Mapping[str, str],
-    setting: Mapping[str, Any],
-    n_boot: int,
-    runs: pd.DataFrame,
-) -> Section:
-    """The UAV report section (order 20): a short body (what was run, symbols, findings, the
-    paper-style CDFs each followed by its paired view) and an appendix (model, tables)."""
-    claims = uav_claims(summary, paired)
-    ac, sc, pl = setting["aircraft"], setting["scenario"], setting["planner"]
-    n_runs = int(summary["n_runs"].max())
-    rs = summary[summary["family"] == "rsmhp"].sort_values("N_T")
-    trees = summary[summary["family"] == "tree"]
-    nts = ", ".join(str(int(n)) for n in rs["N_T"])
-    notes = figure_notes(runs, summary, paired)
-    big = method_label(rs["method"].iloc[-1]) if len(rs) else "RS-MHP"
-
-    methods = ["NBO (one nominal, noise-free target hypothesis)"]
-    if len(rs):
-        methods.append(f"RS-MHP with N_T ∈ {{{nts}}} independently sampled target trajectories")
-    methods += [
-        f"a pruned tree ({int(t['N'])} draws per level, the {int(t['M'])} most likely kept)"
-        for _, t in trees.iterrows()
-    ]
-    n_incl = sum(c.verdict == "inconclusive" for c in claims)
-    verdicts = "; ".join(
-        f"{c.id} {fmt(c.key.value, 2, True)} {fmt_ci(c.key.ci_low, c.key.ci_high, 2, True)} m "
-        f"({c.verdict})"
-        for c in claims
-    )
-    spread = (
-        f"Mean e of every method lies in [{fmt(summary['mean'].min(), 4)}, "
-        f"{fmt(summary['mean'].max(), 4)}] m, while e varies between runs with SD "
-        f"{fmt(summary['sd'].median(), 2)} m. "
-    )
-    half = float(np.median([(c.key.ci_high - c.key.ci_low) / 2 for c in claims] or [0.0]))
-    pct = 100 * half / float(summary["mean"].mean())
-    why = (
-        f"Every CI contains 0: any effect of the method on e is below what {n_runs} paired "
-        f"runs resolve (CI half-width about {fmt(half, 2)} m, {fmt(pct, 2)}% of mean e). "
-        if claims and n_incl == len(claims)
-        else f"{n_incl} of {len(claims)} CIs contain or touch 0. "
-    ) + "The decision study compares the plans themselves (DEC-6, DEC-8)."
-    body = "\n".join(
-        [
-            f"**Run.** {n_runs} closed-loop runs × {sc['steps']} steps (Δt = "
-            f"{_num(setting['dt'])} s) per method: a UAV tracks a ground target with a noisy "
-            "position sensor and a Kalman filter; at every step it plans H = "
-            f"{pl['horizon']} controls minimising Σ_{{k=1..H}} tr P_k (P_k: tracker covariance "
-            "predicted k steps ahead along a target hypothesis) averaged over the method's "
-            f"hypotheses: {', '.join(methods)}. The paper fixes only H = 6 and N_T; the rest is "
-            "our reconstruction (appendix). All methods face the "
-            "same scenario and noise in a run (paired design)." + _variant_note(setting["sensor"]),
-            "",
-            "**Symbols.** e_r = (1/K) Σ_k ‖p̂_k − p_k‖ (m): average target location error of "
-            "run r over its K steps (p̂_k estimate, p_k true position). Paired difference d_r = "
-            "e_r(A) − e_r(B) (< 0: A better), mean d̄ over runs; CI: 95% percentile bootstrap "
-            f"of d̄ ({n_boot} resamples of runs); p: Wilcoxon signed-rank p-value of d.",
-            "",
-            f"**Found.** {spread}Key numbers d̄ (CI): {verdicts}. {why}",
-            "",
-            "![Fig. 4 counterpart](figures/uav_error_cdf_nt.png)",
-            "",
-            _caption(
-                f"Paper Fig. 4 drawn the paper's way: CDF of e_r, RS-MHP N_T = {nts}",
-                notes.get("uav_error_cdf_nt", (0, 0, ""))[2],
-            ),
-            "",
-            "![paired differences, N_T and pruning](figures/uav_paired_diff_nt.png)",
-            "",
-            _caption(
-                "Paired view of Fig. 4: d_r for larger − smaller N_T (UAV-1) and RS-MHP − "
-                "pruned tree (UAV-3), with d̄ and CI",
-                notes.get("uav_paired_diff_nt", (0, 0, ""))[2],
-            ),
-            "",
-            "![Fig. 5 counterpart](figures/uav_error_cdf_nbo.png)",
-            "",
-            _caption(
-                f"Paper Fig. 5 drawn the paper's way: CDF of e_r, NBO vs {big}",
-                notes.get("uav_error_cdf_nbo", (0, 0, ""))[2],
-            ),
-            "",
-            "![paired differences to NBO](figures/uav_paired_diff.png)",
-            "",
-            _caption(
-                "Paired view of Fig. 5: d_r = e_r(method) − e_r(NBO) with d̄ and CI (UAV-2)",
-                notes.get("uav_paired_diff", (0, 0, ""))[2],
-            ),
-        ]
-    )
-    sp, sv = _num(setting["tracker"]["p0_pos_sd"]), _num(setting["tracker"]["p0_vel_sd"])
-    appendix = "\n".join(
-        [
-            "The paper gives only H = 6 and N_T ∈ {50, 100, 250}; every other number is this "
-            "project's reconstruction (`config/config.yaml`, section `uav`; model in "
-            "`rsmhp.uav`).",
-            "",
-            f"Model: Δt = {_num(setting['dt'])} s; UAV at {_num(ac['altitude'])} m altitude, "
-            f"controls |a| ≤ {_num(ac['accel_max'])} m/s², |φ| ≤ {_num(ac['bank_max_deg'])}°, "
-            f"speed in [{_num(ac['speed_min'])}, {_num(ac['speed_max'])}] m/s; target: nearly "
-            f"constant velocity (NCV), q = {_num(setting['target']['q'])} m²/s³; position sensor "
-            f"with range SD σ_r = {_num(setting['sensor']['sigma_r_per_m'])} d and cross-range "
-            f"SD σ_c = {_num(setting['sensor']['sigma_c_per_m'])} d (d: 3-D UAV–target "
-            f"distance); Kalman filter with P0 = diag({sp}², {sp}², {sv}², {sv}²). Planner: "
-            f"horizon H = {pl['horizon']}, cost Σ_{{k=1..H}} tr P_k (P_k: 4×4 covariance "
-            "predicted along a target hypothesis) averaged over the hypotheses, L-BFGS-B on "
-            f"the control box with at most {pl['maxiter']} iterations / {pl['maxfun']} "
-            "evaluations, exact gradient, warm start from the shifted previous plan; identical "
-            "for every method." + _variant_note(setting["sensor"]),
-            "",
-            f"Scenarios: target speed {_num(sc['target_speed_min'])}-"
-            f"{_num(sc['target_speed_max'])} m/s, UAV {_num(sc['uav_distance_min'])}-"
-            f"{_num(sc['uav_distance_max'])} m away at {_num(sc['uav_speed'])} m/s; scenario, "
-            "truth noise and measurement noise of run r come from streams keyed on r only.",
-            "",
-            "Per method (e in m; CIs: 95% percentile bootstrap over runs; tr P̂: trace of the "
-            "tracker's 4×4 covariance, m² + m²/s²; planner s/run: wall time, varies between "
-            "executions):",
-            "",
-            tables["uav_methods"],
-            "",
-            "Paired differences d = e(A) − e(B) (m; negative: A has the lower error):",
-            "",
-            tables["uav_paired"],
-        ]
-    )
-    return Section(
-        key="uav",
-        title="Case study 2: UAV target tracking (paper Sec. III-B, Figs. 4-5)",
-        order=20,
-        body=body,
-        claims=claims,
-        figures=[f"{f}.png" for f in FIGURES],
-        appendix=appendix,
-    )

@@ -41,9 +41,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rsmhp import lqg, samplers
+from rsmhp import designs, lqg
 from rsmhp.contracts import Contract
-from rsmhp.estimators import likeliness_weights
+from rsmhp.cost_estimators import likeliness_weights
 from rsmhp.parallel import parallel_map
 from rsmhp.sampling import sample_tree
 from rsmhp.seeding import job_rngs
@@ -52,6 +52,7 @@ __all__ = [
     "LQG_REGRET_COLUMNS",
     "METHODS",
     "RegretCell",
+    "cell_rows",
     "regret_cells",
     "run_lqg_regret",
     "sobol_budget",
@@ -135,13 +136,13 @@ def _sample(
     if cell.method == "nbo":
         return np.zeros((1, H)), np.ones(1), None
     if cell.method == "cubature":
-        w, wt = samplers.cubature(H, chol)
+        w, wt = designs.cubature(H, chol)
         return w[:, :, 0], wt, None
     if cell.method in ("antithetic", "sobol"):
-        w, wt = getattr(samplers, cell.method)(rng, cell.P, H, chol)
+        w, wt = getattr(designs, cell.method)(rng, cell.P, H, chol)
         return w[:, :, 0], wt, None
     if cell.method == "mc":
-        w, wt = samplers.monte_carlo(rng, cell.P, H, chol)
+        w, wt = designs.monte_carlo(rng, cell.P, H, chol)
         return w[:, :, 0], wt, model.noise.logpdf(w).sum(axis=1)
     if cell.method in ("tree", "pruned"):
         tree = sample_tree(
@@ -158,10 +159,15 @@ def _sample(
     raise ValueError(f"unknown method {cell.method!r}")
 
 
-def _cell_rows(cell: RegretCell, params: Mapping[str, float], seed: int, reps: int) -> Iterator:
-    model = lqg.LQGModel(a=cell.a, r=params["r"], target=params["target"], sigma=params["sigma"])
-    kw = {"x0": params["x0"], "a": cell.a, "r": params["r"], "target": params["target"]}
-    c = (1.0 - cell.a) ** np.arange(cell.H - 1, -1, -1)
+def cell_rows(
+    cell: RegretCell, params: Mapping[str, float], seed: int, reps: int
+) -> Iterator[dict[str, Any]]:
+    """The rows of one cell: per replicate and weighting the regret of the sample-average
+    argmin, the shift :math:`\bar e` and the argmin's components. ``params`` is the
+    ``lqg.model`` config section (x0, r, target, sigma); ``a`` is the cell's."""
+    model = lqg.LQGModel.from_config(params, a=cell.a)
+    kw = model.closed_form_args(sigma=False)
+    c = lqg.coefficients(cell.H, cell.a)
     n_reps = 1 if cell.method in DETERMINISTIC else reps
     rngs = job_rngs(
         seed,
@@ -202,7 +208,7 @@ def _cell_rows(cell: RegretCell, params: Mapping[str, float], seed: int, reps: i
 
 def _task(job: tuple[list[tuple[int, RegretCell]], Mapping[str, float], int, int]) -> list:
     cells, params, seed, reps = job
-    return [(i, list(_cell_rows(cell, params, seed, reps))) for i, cell in cells]
+    return [(i, list(cell_rows(cell, params, seed, reps))) for i, cell in cells]
 
 
 def _columns(max_H: int) -> list[str]:

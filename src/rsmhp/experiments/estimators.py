@@ -39,15 +39,23 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rsmhp import samplers
+from rsmhp import designs
 from rsmhp.contracts import Contract
-from rsmhp.estimators import uniform_estimate, weighted_estimate
+from rsmhp.cost_estimators import uniform_estimate, weighted_estimate
 from rsmhp.linear_quadratic import LinearQuadratic
 from rsmhp.parallel import parallel_map
 from rsmhp.sampling import rollout, rollout_cost, sample_tree, sample_tree_batch
 from rsmhp.seeding import job_rngs
 
-__all__ = ["ABLATION_COLUMNS", "GridPoint", "build_problem", "grid_points", "run_ablation"]
+__all__ = [
+    "ABLATION_COLUMNS",
+    "BATCH_LEAVES",
+    "GridPoint",
+    "build_problem",
+    "grid_points",
+    "n_trajectories",
+    "run_ablation",
+]
 
 log = logging.getLogger(__name__)
 
@@ -141,7 +149,7 @@ def grid_points(cfg: Mapping[str, Any], problems: Mapping[str, LinearQuadratic])
                     if M <= N
                 ]
             elif scheme == "gauss_hermite":
-                qs = sorted({samplers.gauss_hermite_order(n, D) for n in cfg["budgets"]} - {0})
+                qs = sorted({designs.gauss_hermite_order(n, D) for n in cfg["budgets"]} - {0})
                 pts += [GridPoint(name, scheme, N=q) for q in qs]
             elif scheme in ("cubature", "nbo"):
                 pts.append(GridPoint(name, scheme))
@@ -150,7 +158,7 @@ def grid_points(cfg: Mapping[str, Any], problems: Mapping[str, LinearQuadratic])
     return pts
 
 
-def _n_trajectories(point: GridPoint, prob: LinearQuadratic) -> int:
+def n_trajectories(point: GridPoint, prob: LinearQuadratic) -> int:
     """Trajectories (leaves, points) behind one estimate of ``point``."""
     s, H, D = point.scheme, prob.H, prob.H * prob.d
     if s in ("mc", "antithetic", "sobol"):
@@ -167,7 +175,7 @@ def _n_trajectories(point: GridPoint, prob: LinearQuadratic) -> int:
 
 def _weightings(scheme: str) -> tuple[str, ...]:
     """The ``weighting`` values of a scheme's rows (see :func:`_rows`)."""
-    if scheme in samplers.DETERMINISTIC:
+    if scheme in designs.DETERMINISTIC:
         return ("quadrature",)
     if scheme == "nbo":
         return ("nominal",)
@@ -182,7 +190,7 @@ def ablation_contract(cfg: Mapping[str, Any], lqg_model: Mapping[str, Any]) -> C
     problems = {name: build_problem(spec, lqg_model) for name, spec in specs.items()}
     reps = int(cfg["replicates"])
     keys = [
-        (p.problem, p.scheme, w, p.N, p.M, _n_trajectories(p, problems[p.problem]), r)
+        (p.problem, p.scheme, w, p.N, p.M, n_trajectories(p, problems[p.problem]), r)
         for p in grid_points(cfg, problems)
         for w in _weightings(p.scheme)
         for r in range(1 if p.deterministic else reps)
@@ -204,10 +212,10 @@ def _sample(point: GridPoint, prob: LinearQuadratic, rng: np.random.Generator | 
     H = prob.H
     s = point.scheme
     if s == "mc":
-        traj = rollout(prob, prob.x0, prob.u, samplers.monte_carlo(rng, point.n, H, chol)[0])
+        traj = rollout(prob, prob.x0, prob.u, designs.monte_carlo(rng, point.n, H, chol)[0])
         return traj.cost, traj.log_likeliness, None, point.n * H
     if s in ("antithetic", "sobol"):
-        w, wt = getattr(samplers, s)(rng, point.n, H, chol)
+        w, wt = getattr(designs, s)(rng, point.n, H, chol)
         return rollout_cost(prob, prob.x0, prob.u, w), None, wt, point.n * H
     if s in ("tree", "tree_pernode", "pruned"):
         tree = sample_tree(
@@ -221,10 +229,10 @@ def _sample(point: GridPoint, prob: LinearQuadratic, rng: np.random.Generator | 
         )
         return tree.leaves.cost, tree.leaves.log_likeliness, None, _tree_nodes(point, H)
     if s == "cubature":
-        w, wt = samplers.cubature(H, chol)
+        w, wt = designs.cubature(H, chol)
         return rollout_cost(prob, prob.x0, prob.u, w), None, wt, len(wt) * H
     if s == "gauss_hermite":
-        w, wt = samplers.gauss_hermite(point.N, H, chol)
+        w, wt = designs.gauss_hermite(point.N, H, chol)
         return rollout_cost(prob, prob.x0, prob.u, w), None, wt, len(wt) * H
     if s == "nbo":
         return rollout_cost(prob, prob.x0, prob.u, np.zeros((1, H, prob.d))), None, np.ones(1), H
@@ -243,7 +251,7 @@ def _tree_nodes(point: GridPoint, H: int) -> int:
 
 
 # trees of one cell sampled together (bounded memory: leaves x replicates per batch)
-_BATCH_LEAVES = 1 << 20
+BATCH_LEAVES = 1 << 20
 
 
 def _batched_tree_samples(point: GridPoint, prob: LinearQuadratic, rngs: list) -> Iterator:
@@ -251,7 +259,7 @@ def _batched_tree_samples(point: GridPoint, prob: LinearQuadratic, rngs: list) -
     with :func:`rsmhp.sampling.sample_tree_batch` (bit-identical to one tree at a time for
     these row-wise problems; see its docstring)."""
     leaves = point.M if point.scheme == "pruned" else point.N**prob.H
-    per_batch = max(1, _BATCH_LEAVES // max(leaves, 1))
+    per_batch = max(1, BATCH_LEAVES // max(leaves, 1))
     for start in range(0, len(rngs), per_batch):
         chunk = rngs[start : start + per_batch]
         t0 = time.process_time()
@@ -269,7 +277,10 @@ def _batched_tree_samples(point: GridPoint, prob: LinearQuadratic, rngs: list) -
             yield cost[r], loglik[r], cpu
 
 
-def _rows(point: GridPoint, prob: LinearQuadratic, spec: Mapping, seed: int, reps: int) -> Iterator:
+def ablation_rows(
+    point: GridPoint, prob: LinearQuadratic, spec: Mapping, seed: int, reps: int
+) -> Iterator:
+    """The ablation rows of one grid point (every replicate), lazily (memory estimates)."""
     j_exact, j_nbo = prob.exact_cost(), prob.nbo_cost()
     n_reps = 1 if point.deterministic else reps
     rngs = job_rngs(
@@ -300,7 +311,7 @@ def _rows(point: GridPoint, prob: LinearQuadratic, spec: Mapping, seed: int, rep
         if wts is not None:
             estimates = {
                 "quadrature"
-                if point.scheme in samplers.DETERMINISTIC
+                if point.scheme in designs.DETERMINISTIC
                 else "nominal"
                 if point.scheme == "nbo"
                 else "uniform": float(wts @ cost)
@@ -334,7 +345,7 @@ def _task(job) -> list[dict]:
     for point in points:
         spec = problem_specs[point.problem]
         prob = build_problem(spec, lqg_model)
-        out.extend(_rows(point, prob, spec, seed, reps))
+        out.extend(ablation_rows(point, prob, spec, seed, reps))
     return out
 
 

@@ -9,7 +9,6 @@ from __future__ import annotations
 import itertools
 import logging
 from collections.abc import Mapping
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -17,7 +16,7 @@ import pandas as pd
 
 from rsmhp import lqg
 from rsmhp.contracts import Contract
-from rsmhp.estimators import nbo_estimate, uniform_estimate, weighted_estimate
+from rsmhp.cost_estimators import nbo_estimate, uniform_estimate, weighted_estimate
 from rsmhp.parallel import chunked, parallel_map
 from rsmhp.sampling import sample_independent
 from rsmhp.seeding import job_rng
@@ -25,7 +24,9 @@ from rsmhp.seeding import job_rng
 __all__ = [
     "CONVERGENCE_COLUMNS",
     "NBO_ERROR_COLUMNS",
-    "LQGParams",
+    "convergence_contract",
+    "estimate_row",
+    "nbo_error_contract",
     "p_grid",
     "run_convergence",
     "run_nbo_error",
@@ -67,36 +68,9 @@ NBO_ERROR_COLUMNS = [
 ]
 
 
-@dataclass(frozen=True)
-class LQGParams:
-    """Model parameters of the oven LQG (see :mod:`rsmhp.lqg`)."""
-
-    a: float
-    x0: float
-    r: float
-    target: float
-    sigma: float
-
-    @classmethod
-    def from_config(cls, model: Mapping[str, Any], a: float | None = None) -> LQGParams:
-        return cls(
-            a=float(model["a"] if a is None else a),
-            x0=float(model["x0"]),
-            r=float(model["r"]),
-            target=float(model["target"]),
-            sigma=float(model["sigma"]),
-        )
-
-    def model(self) -> lqg.LQGModel:
-        return lqg.LQGModel(a=self.a, r=self.r, target=self.target, sigma=self.sigma)
-
-    def closed(self) -> dict[str, float]:
-        """Keyword arguments of the closed forms in :mod:`rsmhp.lqg`."""
-        return {"x0": self.x0, "a": self.a, "r": self.r, "target": self.target, "sigma": self.sigma}
-
-
-def _constants(params: LQGParams) -> dict[str, float]:
-    return {k: getattr(params, k) for k in ("a", "sigma", "r", "target", "x0")}
+def _constants(model: lqg.LQGModel) -> dict[str, float]:
+    """The model constants as the CSV columns hold them (column order of the tables)."""
+    return {k: getattr(model, k) for k in ("a", "sigma", "r", "target", "x0")}
 
 
 def convergence_contract(cfg: Mapping[str, Any]) -> Contract:
@@ -113,7 +87,7 @@ def convergence_contract(cfg: Mapping[str, Any]) -> Contract:
         keys=("P", "replicate"),
         expected=pd.DataFrame(list(keys), columns=["P", "replicate"]),
         values={
-            **_constants(LQGParams.from_config(cfg["model"])),
+            **_constants(lqg.LQGModel.from_config(cfg["model"])),
             "H": len(conv["u"]),
             "u": ";".join(repr(float(v)) for v in conv["u"]),
         },
@@ -129,7 +103,7 @@ def nbo_error_contract(cfg: Mapping[str, Any]) -> Contract:
         [int(h) for h in ne["H_values"]],
         range(int(ne["replicates"])),
     )
-    params = _constants(LQGParams.from_config(cfg["model"]))
+    params = _constants(lqg.LQGModel.from_config(cfg["model"]))
     del params["a"]
     return Contract(
         rule="lqg_nbo_error",
@@ -147,24 +121,26 @@ def p_grid(spec: Mapping[str, int]) -> list[int]:
     return list(range(int(spec["start"]), int(spec["stop"]) + 1, int(spec["step"])))
 
 
-def _estimate_row(
-    seed: int, experiment: str, params: LQGParams, u: np.ndarray, P: int, replicate: int
+def estimate_row(
+    seed: int, experiment: str, model: lqg.LQGModel, u: np.ndarray, P: int, replicate: int
 ) -> tuple[float, float, float]:
-    """One MHP estimate from P non-overlapping trajectories: (uniform, weighted, std of costs)."""
+    """One MHP estimate from P non-overlapping trajectories of ``model`` under controls ``u``
+    (from ``model.x0``): (uniform, weighted, std of the P costs; NaN for P = 1). The noise comes
+    from ``job_rng(seed, experiment, a=, H=, sigma=, r=, target=, x0=, u=, P=, replicate=)``."""
     rng = job_rng(
         seed,
         experiment,
-        a=params.a,
+        a=model.a,
         H=len(u),
-        sigma=params.sigma,
-        r=params.r,
-        target=params.target,
-        x0=params.x0,
+        sigma=model.sigma,
+        r=model.r,
+        target=model.target,
+        x0=model.x0,
         u=u,
         P=P,
         replicate=replicate,
     )
-    traj = sample_independent(params.model(), [params.x0], u, P, rng)
+    traj = sample_independent(model, [model.x0], u, P, rng)
     return (
         float(uniform_estimate(traj.cost)),
         float(weighted_estimate(traj.cost, traj.log_likeliness)),
@@ -172,16 +148,18 @@ def _estimate_row(
     )
 
 
-def _convergence_chunk(job: tuple[int, LQGParams, tuple[float, ...], list[int], int]) -> list[dict]:
+def _convergence_chunk(
+    job: tuple[int, lqg.LQGModel, tuple[float, ...], list[int], int],
+) -> list[dict]:
     seed, params, u_t, p_values, replicates = job
     u = np.asarray(u_t)
-    j_nbo = lqg.nbo_cost(u, x0=params.x0, a=params.a, r=params.r, target=params.target)
-    j_exact = lqg.exact_cost(u, **params.closed())
+    j_nbo = lqg.nbo_cost(u, **params.closed_form_args(sigma=False))
+    j_exact = lqg.exact_cost(u, **params.closed_form_args())
     u_text = ";".join(repr(float(v)) for v in u)
     rows = []
     for P in p_values:
         for rep in range(replicates):
-            j_u, j_w, _ = _estimate_row(seed, "lqg_convergence", params, u, P, rep)
+            j_u, j_w, _ = estimate_row(seed, "lqg_convergence", params, u, P, rep)
             rows.append(
                 {
                     "a": params.a,
@@ -208,7 +186,7 @@ def run_convergence(cfg: Mapping[str, Any], seed: int, n_jobs: int = 1) -> pd.Da
 
     ``cfg`` is the ``lqg`` config section (``model`` and ``convergence``).
     """
-    params = LQGParams.from_config(cfg["model"])
+    params = lqg.LQGModel.from_config(cfg["model"])
     conv = cfg["convergence"]
     u = tuple(float(v) for v in conv["u"])
     ps = p_grid(conv["P"])
@@ -238,14 +216,13 @@ def _nbo_error_chunk(job: tuple[int, Mapping[str, Any], list[tuple[float, int]]]
     P, reps, u_value = int(ne["P"]), int(ne["replicates"]), float(ne["u_value"])
     rows = []
     for a, H in grid:
-        params = LQGParams.from_config(cfg["model"], a=a)
+        params = lqg.LQGModel.from_config(cfg["model"], a=a)
         u = np.full(H, u_value)
-        system = params.model()
-        j_nbo_sim = nbo_estimate(system, [params.x0], u)
+        j_nbo_sim = nbo_estimate(params, [params.x0], u)
         closed = lqg.nbo_error(H, a=params.a, r=params.r, sigma=params.sigma)
-        j_exact = lqg.exact_cost(u, **params.closed())
+        j_exact = lqg.exact_cost(u, **params.closed_form_args())
         for rep in range(reps):
-            j_u, _, sd = _estimate_row(seed, "lqg_nbo_error", params, u, P, rep)
+            j_u, _, sd = estimate_row(seed, "lqg_nbo_error", params, u, P, rep)
             rows.append(
                 {
                     "a": params.a,

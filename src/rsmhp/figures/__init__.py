@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import os
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 
 import matplotlib
@@ -12,25 +10,9 @@ import matplotlib
 matplotlib.use("Agg")
 
 import matplotlib.pyplot as plt
-import numpy as np
 import seaborn as sns
 
-from rsmhp.seeding import job_seed_sequence
-
-__all__ = ["save_figure", "seeded_legacy_random", "theme"]
-
-
-@contextmanager
-def seeded_legacy_random(figure: str) -> Iterator[None]:
-    """Seed NumPy's legacy global generator (which seaborn's strip-plot jitter uses) from the
-    job id ``("figure", figure)`` for the duration of the block, then restore its state, so
-    that redrawing a figure gives identical pixels."""
-    state = np.random.get_state()  # noqa: NPY002 (seaborn draws from the legacy generator)
-    np.random.seed(int(job_seed_sequence(0, "figure", figure=figure).generate_state(1)[0]))  # noqa: NPY002
-    try:
-        yield
-    finally:
-        np.random.set_state(state)  # noqa: NPY002
+__all__ = ["save_figure", "theme"]
 
 
 def theme() -> None:

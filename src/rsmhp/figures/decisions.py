@@ -14,10 +14,10 @@ import numpy as np
 import pandas as pd
 from matplotlib.lines import Line2D
 
-from rsmhp.analysis.decisions import (
+from rsmhp.analysis.decisions_lqg import ZERO_REGRET
+from rsmhp.analysis.decisions_uav import (
     REGRET_FLOOR_PCT,
     REGRET_FLOOR_TEXT,
-    ZERO_REGRET,
     axis_label,
     axis_value,
 )
@@ -162,7 +162,7 @@ def uav_regret_figure(regret: pd.DataFrame) -> plt.Figure:
     (methods and multi-start), bottom row against the best of the methods' plans only (the
     part due to the cost approximation). Points in the method's palette colour, a grey box
     per method (quartiles, whiskers 1.5 IQR); values below
-    :data:`rsmhp.analysis.decisions.REGRET_FLOOR_PCT` percent
+    :data:`rsmhp.analysis.decisions_uav.REGRET_FLOOR_PCT` percent
     (zero included) are drawn at it and counted in each panel."""
     theme()
     floor = REGRET_FLOOR_PCT
@@ -273,8 +273,7 @@ def uav_map_figure(map_df: pd.DataFrame) -> plt.Figure:
         ax.set_xticks(range(len(cols)), cols)
         ax.set_yticks(range(len(rows)), rows)
         ax.grid(False)
-        method = comp.split(" ")[0]
-        ax.set_title(f"{method_label(method)} − NBO")
+        ax.set_title(" − ".join(method_label(m) for m in comp.split(" − ")))
         ax.set_xlabel(axis_label(col_key))
         ax.set_ylabel(axis_label(row_key))
     cbar = fig.colorbar(image, ax=axes[0].tolist(), shrink=0.9)

@@ -16,9 +16,11 @@ import numpy as np
 import pandas as pd
 import seaborn as sns
 
-from rsmhp.analysis.lqg import NBO_Z_CLIP, chebyshev_long, eps_label, fmt_exact, nbo_z_limit
+from rsmhp.analysis.lqg import chebyshev_long, eps_label, nbo_z_limit
+from rsmhp.claims.lqg import fmt_exact
 from rsmhp.figures import theme
 from rsmhp.markdown import fmt
+from rsmhp.narrative.lqg import NBO_Z_CLIP
 from rsmhp.palette import LINESTYLES, method_colour, method_label
 
 __all__ = [

@@ -19,11 +19,11 @@ import pandas as pd
 from rsmhp.analysis.uav import (
     cdf_methods,
     cdf_range,
-    key_comparisons,
     paired_range,
     paired_view,
     per_run_differences,
 )
+from rsmhp.claims.uav import key_comparisons
 from rsmhp.figures import theme
 from rsmhp.palette import LINESTYLES, method_colour, method_label
 from rsmhp.seeding import job_rng

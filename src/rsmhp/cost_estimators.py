@@ -23,7 +23,7 @@ from __future__ import annotations
 import numpy as np
 
 from rsmhp import guards
-from rsmhp.sampling import System, _controls, _initial_state
+from rsmhp.sampling import System, check_controls, check_initial_state
 
 __all__ = ["likeliness_weights", "nbo_estimate", "uniform_estimate", "weighted_estimate"]
 
@@ -91,8 +91,8 @@ def nbo_estimate(system: System, x0: np.ndarray, u: np.ndarray | list[float]) ->
     r"""NBO cost: the cost of the single trajectory with every noise at its mean,
     :math:`\tilde x_{k+1} = f(\tilde x_k, u_k, \bar w_k)`, :math:`J_{NBO} = \sum_k g(\tilde x_k,
     u_k) + g_H(\tilde x_H)`."""
-    u = _controls(u)
-    _initial_state(system, x0)
+    u = check_controls(u)
+    check_initial_state(system, x0)
     x = np.atleast_1d(np.asarray(x0, dtype=float))[None, :]
     w = system.noise.mean[None, :]
     total = 0.0

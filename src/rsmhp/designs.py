@@ -1,10 +1,10 @@
-r"""Noise samplers on a fixed budget of ``n`` trajectories, beyond the paper's plain Monte Carlo.
+r"""Noise designs on a fixed budget of ``n`` trajectories, beyond the paper's plain Monte Carlo.
 
-Every sampler returns ``(noise, weights)``: noise sequences of shape ``(n, H, d)`` for
+Every design returns ``(noise, weights)``: noise sequences of shape ``(n, H, d)`` for
 :func:`rsmhp.sampling.rollout` and weights (summing to 1) for the cost average
 :math:`\hat J = \sum_i \omega_i g_i`. The stacked noise :math:`w \in \mathbb R^{D}`,
 :math:`D = Hd`, is :math:`\mathcal N(0, I_H \otimes \Sigma)`; with :math:`L L^\top = \Sigma`
-each sampler produces standard normal :math:`z` and maps :math:`w_k = L z_k`.
+each design produces standard normal :math:`z` and maps :math:`w_k = L z_k`.
 
 * ``mc``            i.i.d. draws, :math:`\omega_i = 1/n` (the paper's non-overlapping MHP).
 * ``antithetic``    :math:`n/2` draws and their negatives; unbiased, and for a quadratic cost

@@ -1,0 +1,1 @@
+"""Report sections of each study: prose, tables and appendix in Markdown, from its claims."""
