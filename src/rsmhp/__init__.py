@@ -23,7 +23,7 @@ Models
                     methods, one module per family), simulation, recording
 Stages of the pipeline (one module per model and stage)
   experiments       lqg, estimators, uav, decisions_lqg, decisions_uav: config -> tidy tables
-  analysis          lqg, estimators, uav, decisions: tables -> statistics (summaries, fits, CIs)
+  analysis          lqg, estimators, uav, decisions_lqg, decisions_uav: tables -> statistics
   figures           lqg, estimators, uav, decisions: seaborn figures (PNG + PDF)
   recording         rerun recordings of sampled trajectory trees
   claims            per study: the claims (key number + verdict rule) from the statistics

@@ -1,7 +1,8 @@
 # Decision-quality study: the regret of the controls each method chooses.
 # Simulation, aggregation and figures are separate rules; the sensitivity map runs one job
 # per cell (wildcard {cell} = r<i>c<j>), so a cell reruns alone and cells fan out.
-from rsmhp.analysis.decisions import LQG_FIGURES, UAV_FIGURES
+from rsmhp.narrative.decisions_lqg import FIGURES as LQG_FIGURES
+from rsmhp.narrative.decisions_uav import FIGURES as UAV_FIGURES
 from rsmhp.experiments.decisions_uav import map_cells
 
 DEC = config["decisions"]
