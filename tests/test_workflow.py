@@ -533,7 +533,10 @@ def test_code_edits_rerun_exactly_the_rules_that_import_the_code(run_j2, tmp_pat
             if rule in users
             and module in describe(wf / "workflow/scripts" / script, wf / "src").modules
         }
-        assert params == importers, module  # Snakemake's reason: the `code` param changed
+        # Snakemake's reason is the changed `code` param for every importer, except those
+        # it schedules already because an input is remade (downstream of another importer)
+        roots = {r for r in importers if r not in _downstream(importers - {r}, users)}
+        assert roots <= params <= importers, module
         assert scheduled == _downstream(importers, users) - TARGET_RULES, module
         return scheduled, params, importers
 
