@@ -124,13 +124,17 @@ class Section:
     appendix: str = ""
 
     def save(self, path: str | os.PathLike) -> None:
+        """Write the section atomically as JSON; in a rule, with the code stamp ``code``."""
+        from rsmhp.io import write_json
+
         Path(path).parent.mkdir(parents=True, exist_ok=True)
-        Path(path).write_text(json.dumps(asdict(self), indent=2) + "\n", encoding="utf-8")
+        write_json(asdict(self), path)
 
     @classmethod
     def load(cls, path: str | os.PathLike) -> Section:
         try:
             data = json.loads(Path(path).read_text(encoding="utf-8"))
+            data.pop("code", None)  # the code stamp (rsmhp.io), checked by the report rule
             data["claims"] = [Claim.from_dict(c) for c in data.get("claims", [])]
             return cls(**data)
         except (OSError, ValueError, TypeError, KeyError) as exc:
