@@ -10,7 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-__all__ = ["escape", "fmt", "fmt_ci", "markdown_table"]
+__all__ = ["escape", "fmt", "fmt_ci", "markdown_table", "param_text", "range_text"]
 
 
 def fmt(x: float | int, digits: int = 3, signed: bool = False) -> str:
@@ -92,3 +92,24 @@ def markdown_table(
                 cells.append(fmt(v, digits, col in signed))
         out[col] = cells
     return out.to_markdown(index=False, disable_numparse=True, colalign=align)
+
+
+def param_text(x: float | int) -> str:
+    """A configuration value as text: whole numbers without decimals, others with the fewest
+    significant digits that give the value back exactly (``0.25``, not ``0.250``)."""
+    xf = float(x)
+    if xf.is_integer():
+        return fmt(int(xf))
+    for digits in range(1, 16):
+        text = fmt(xf, digits)
+        if float(text) == xf:
+            return text
+    return fmt(xf, 6)
+
+
+def range_text(values: Sequence[float], digits: int = 3, signed: bool = False) -> str:
+    """``lo to hi`` of ``values`` (one number if they are all equal)."""
+    lo, hi = float(np.min(values)), float(np.max(values))
+    if lo == hi:
+        return fmt(lo, digits, signed)
+    return f"{fmt(lo, digits, signed)} to {fmt(hi, digits, signed)}"

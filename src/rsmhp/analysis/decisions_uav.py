@@ -32,7 +32,7 @@ import pandas as pd
 from scipy import stats as sps
 
 from rsmhp.analysis.uav import baseline_name, is_family
-from rsmhp.markdown import fmt
+from rsmhp.markdown import param_text
 from rsmhp.seeding import job_rng
 from rsmhp.stats import bootstrap_ci
 from rsmhp.uav import methods as registry
@@ -55,7 +55,6 @@ __all__ = [
     "optimiser_share",
     "paired_errors",
     "paired_regret",
-    "param_text",
     "summarize_map",
     "summarize_map_groups",
     "summarize_uav_regret",
@@ -129,19 +128,6 @@ MAP_AXES = {
     "tracker.p0_pos_sd": ("initial position sd", "m"),
     "tracker.p0_vel_sd": ("initial velocity sd", "m/s"),
 }
-
-
-def param_text(x: float | int) -> str:
-    """A configuration value as text: whole numbers without decimals, others with the fewest
-    significant digits that give the value back exactly (``0.25``, not ``0.250``)."""
-    xf = float(x)
-    if xf.is_integer():
-        return fmt(int(xf))
-    for digits in range(1, 16):
-        text = fmt(xf, digits)
-        if float(text) == xf:
-            return text
-    return fmt(xf, 6)
 
 
 def axis_label(key: str) -> str:

@@ -29,7 +29,7 @@ from rsmhp.analysis.decisions_lqg import (
     z_families,
 )
 from rsmhp.ledger import Claim, KeyNumber
-from rsmhp.markdown import fmt
+from rsmhp.markdown import fmt, param_text, range_text
 from rsmhp.verdicts import Case, Facts, Rule
 
 __all__ = [
@@ -51,27 +51,6 @@ NBO_SEVERE = 0.01
 #: DEC-4: a slope of mean regret in M above this (CI and all) means "no useful improvement":
 #: 10x more kept trajectories lower the regret by less than 21%, a tenth of the 1/P rate
 PRUNED_FLAT = -0.1
-
-
-def param_text(x: float | int) -> str:
-    """A configuration value as text: whole numbers without decimals, others with the fewest
-    significant digits that give the value back exactly (``0.25``, not ``0.250``)."""
-    xf = float(x)
-    if xf.is_integer():
-        return fmt(int(xf))
-    for digits in range(1, 16):
-        text = fmt(xf, digits)
-        if float(text) == xf:
-            return text
-    return fmt(xf, 6)
-
-
-def range_text(values: pd.Series, digits: int = 3, signed: bool = False) -> str:
-    """``lo to hi`` of ``values`` (one number if they are all equal)."""
-    lo, hi = float(values.min()), float(values.max())
-    if lo == hi:
-        return fmt(lo, digits, signed)
-    return f"{fmt(lo, digits, signed)} to {fmt(hi, digits, signed)}"
 
 
 def cell_text(row: pd.Series) -> str:

@@ -30,11 +30,10 @@ from rsmhp.analysis.decisions_uav import (
     largest_rsmhp,
     optimiser_share,
     paired_regret,
-    param_text,
 )
 from rsmhp.analysis.uav import baseline_name, is_family
 from rsmhp.ledger import Claim, KeyNumber
-from rsmhp.markdown import fmt
+from rsmhp.markdown import fmt, param_text, range_text
 from rsmhp.palette import method_label
 from rsmhp.uav.methods.monte_carlo import MonteCarlo
 from rsmhp.verdicts import Case, Facts, Rule, ci_side
@@ -126,14 +125,6 @@ def map_facts(group: pd.Series) -> Facts:
         "cells below 0": int(group["n_below"]),
         "cells above 0": int(group["n_above"]),
     }
-
-
-def range_text(values: pd.Series, digits: int = 3, signed: bool = False) -> str:
-    """``lo to hi`` of ``values`` (one number if they are all equal)."""
-    lo, hi = float(values.min()), float(values.max())
-    if lo == hi:
-        return fmt(lo, digits, signed)
-    return f"{fmt(lo, digits, signed)} to {fmt(hi, digits, signed)}"
 
 
 def _regret_key(method: str, m: float, lo: float, hi: float, null: float | None) -> KeyNumber:

@@ -18,9 +18,9 @@ from rsmhp.analysis.decisions_lqg import (
     slopes,
     z_families,
 )
-from rsmhp.claims.decisions_lqg import lqg_claims, param_text, range_text
+from rsmhp.claims.decisions_lqg import lqg_claims
 from rsmhp.ledger import Claim, Section
-from rsmhp.markdown import fmt, fmt_ci, markdown_table
+from rsmhp.markdown import fmt, fmt_ci, markdown_table, param_text, range_text
 
 __all__ = ["FIGURES", "lqg_decision_section", "lqg_tables", "shown_a"]
 

@@ -20,12 +20,11 @@ from rsmhp.analysis.decisions_uav import (
     base_model,
     largest_rsmhp,
     optimiser_share,
-    param_text,
 )
 from rsmhp.analysis.uav import baseline_name
 from rsmhp.claims.decisions_uav import pp, uav_claims
 from rsmhp.ledger import Claim, Section
-from rsmhp.markdown import fmt, fmt_ci, markdown_table
+from rsmhp.markdown import fmt, fmt_ci, markdown_table, param_text
 from rsmhp.palette import method_label
 
 __all__ = ["FIGURES", "uav_decision_section", "uav_tables"]
