@@ -186,10 +186,14 @@ def test_every_rule_script_hands_the_snakemake_object_to_rule_logging():
 
 
 def test_the_real_scripts_import_only_what_they_need():
-    """The LQG simulations do not depend on the UAV model (editing it reruns none of them),
-    and every script depends on the io layer that stamps its outputs."""
+    """The LQG and estimator rules (simulations, summaries, figures, recordings) do not depend
+    on the UAV model (editing it reruns none of them), and every script depends on the io
+    layer that stamps its outputs."""
     src = ROOT / "src"
-    for name in ("lqg_convergence", "lqg_nbo_error", "estimators_ablation", "decisions_lqg"):
+    for name in (
+        "lqg_convergence", "lqg_nbo_error", "lqg_summary", "lqg_figures", "tree_recording",
+        "estimators_ablation", "estimators_summary", "estimators_figures", "decisions_lqg",
+    ):  # fmt: skip
         mods = describe(ROOT / f"workflow/scripts/{name}.py", src).modules
         assert not any(m.startswith("rsmhp.uav") for m in mods), name
         assert "rsmhp.io" in mods and "rsmhp.pipeline" in mods

@@ -1,8 +1,12 @@
 """One colour per method (rsmhp.palette), shared by figures and recordings."""
 
+import ast
+from pathlib import Path
+
 import pytest
 
-from rsmhp import recording
+import rsmhp.uav.methods  # registers the UAV method names with the palette
+from rsmhp import palette, recording
 from rsmhp.palette import METHOD_COLOURS, method_colour, method_label, method_rgb
 
 #: every method name that appears in a results table of the pipeline
@@ -41,6 +45,23 @@ def test_unknown_methods_are_refused_by_name():
         method_colour("magic")
     with pytest.raises(ValueError, match="'magic'"):
         method_label("magic")
+
+
+def test_uav_names_are_resolved_by_the_registry_the_palette_does_not_import(monkeypatch):
+    """The palette knows UAV methods only through a registered resolver (so the LQG figures
+    do not depend on the UAV code); without one, a UAV name is refused with the reason."""
+    tree = ast.parse(Path(palette.__file__).read_text())
+    imported = [n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
+    imported += [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
+    assert imported and not any(str(m).startswith("rsmhp") for m in imported), imported
+    monkeypatch.setattr(palette, "_RESOLVERS", [])
+    with pytest.raises(ValueError, match=r"import rsmhp\.uav\.methods"):
+        method_colour("rsmhp_nt250")
+    assert method_colour("nbo") == METHOD_COLOURS["nbo"]  # fixed schemes need no resolver
+    palette.register_resolver(rsmhp.uav.methods.from_name)
+    palette.register_resolver(rsmhp.uav.methods.from_name)  # twice: no-op
+    assert palette._RESOLVERS == [rsmhp.uav.methods.from_name]
+    assert method_label("rsmhp_nt250") == "RS-MHP N_T=250"
 
 
 def test_recordings_use_the_figure_colours():

@@ -6,7 +6,10 @@ fixed colours here: ``nbo``, ``mc`` (independent, non-overlapping trajectories),
 ``antithetic``, ``sobol``, ``cubature``, ``gauss_hermite``; ``exact`` is the exact cost or
 optimum. A UAV planning method (``rsmhp_nt<N_T>``, ``tree_n<N>_m<M>``, any registered
 family) takes the colour its family module declares (:mod:`rsmhp.uav.methods`; RS-MHP N_T
-in shades of the ``mc`` blue, darker for larger N_T). Colours come from
+in shades of the ``mc`` blue, darker for larger N_T). This module does not import the UAV
+registry (so that the LQG and estimator figures do not depend on the UAV model's code): the
+registry adds itself with :func:`register_resolver` when it is imported, and a UAV name met
+before that raises a ``ValueError`` saying so. Colours come from
 seaborn's colour-blind palette (as RGB hex strings, so this module needs no plotting library);
 derived or closed-form curves use the method's colour with a dashed line, likeliness-weighted
 variants a dotted one (:data:`LINESTYLES`).
@@ -14,12 +17,16 @@ variants a dotted one (:data:`LINESTYLES`).
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from typing import Any
+
 __all__ = [
     "LINESTYLES",
     "METHOD_COLOURS",
     "method_colour",
     "method_label",
     "method_rgb",
+    "register_resolver",
 ]
 
 #: seaborn "colorblind" palette, in its order (C0..C9)
@@ -65,17 +72,31 @@ def method_colour(method: str) -> str:
     return _uav_method(method).shade()
 
 
-def _uav_method(method: str):
-    """The registered UAV planning method called ``method`` (``ValueError`` if none)."""
-    from rsmhp.uav import methods  # the registry imports this module: import on use
+#: lookups of method names beyond the fixed schemes (name -> object with ``shade()`` and
+#: ``label()``, ``ValueError`` if the name is not theirs), in registration order
+_RESOLVERS: list[Callable[[str], Any]] = []
 
-    try:
-        return methods.from_name(str(method).lower())
-    except ValueError:
-        raise ValueError(
-            f"method {method!r} has no colour (allowed: {sorted(METHOD_COLOURS)}, or a "
-            "registered UAV method: rsmhp_nt<N_T>, tree_n<N>_m<M>, ...)"
-        ) from None
+
+def register_resolver(resolve: Callable[[str], Any]) -> None:
+    """Let ``resolve(name)`` (an object with ``shade()`` and ``label()``, or ``ValueError``)
+    colour and label the method names it knows; registering the same callable twice is a
+    no-op. The UAV method registry registers :func:`rsmhp.uav.methods.from_name`."""
+    if resolve not in _RESOLVERS:
+        _RESOLVERS.append(resolve)
+
+
+def _uav_method(method: str):
+    """The registered method called ``method`` (``ValueError`` if no resolver knows it)."""
+    for resolve in _RESOLVERS:
+        try:
+            return resolve(str(method).lower())
+        except ValueError:
+            continue
+    hint = "" if _RESOLVERS else " (the UAV registry is not imported: import rsmhp.uav.methods)"
+    raise ValueError(
+        f"method {method!r} has no colour (allowed: {sorted(METHOD_COLOURS)}, or a "
+        f"registered UAV method: rsmhp_nt<N_T>, tree_n<N>_m<M>, ...){hint}"
+    )
 
 
 def method_rgb(method: str) -> tuple[int, int, int]:

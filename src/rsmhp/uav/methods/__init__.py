@@ -21,6 +21,7 @@ import pkgutil
 from collections.abc import Iterable, Mapping
 from typing import Any
 
+from rsmhp import palette
 from rsmhp.uav.methods.base import COLUMNS, Hypotheses, Method
 
 __all__ = [
@@ -165,3 +166,4 @@ def _import_families() -> None:
 
 
 _import_families()
+palette.register_resolver(from_name)  # UAV method names get their family's colour and label
