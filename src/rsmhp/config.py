@@ -306,6 +306,19 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
             f"(allowed: {', '.join(map(str, names))})"
         )
     mp = dec.get("map", {}) or {}
+    claim_method = (dec.get("claims", {}) or {}).get("map_method") or ""
+    map_methods = mp.get("methods")
+    if claim_method and isinstance(map_methods, Mapping):
+        try:
+            run = [n for n, m in uav_methods.from_config(map_methods).items() if not m.baseline]
+        except (ValueError, TypeError):
+            run = []  # reported above by the families' own checks
+        if run and claim_method not in run:
+            problems.append(
+                f"decisions.claims.map_method: {claim_method!r} is not a method of "
+                f"decisions.map.methods (allowed: {', '.join(run)}, or '' for the first "
+                "RS-MHP member)"
+            )
     keys = []
     for axis in ("rows", "cols"):
         ax = mp.get(axis) or {}

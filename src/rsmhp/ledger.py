@@ -16,9 +16,29 @@ from typing import Any
 
 from rsmhp.markdown import fmt, fmt_ci
 
-__all__ = ["REPRODUCIBILITY", "VERDICTS", "Claim", "KeyNumber", "Section", "claims_records"]
+__all__ = [
+    "PARTS",
+    "REPRODUCIBILITY",
+    "STATEMENT_VERDICTS",
+    "VERDICTS",
+    "Claim",
+    "KeyNumber",
+    "Section",
+    "claims_records",
+]
 
-VERDICTS = ("supported", "not supported", "inconclusive")
+#: verdicts of a claim: its key number's CI lies on the claimed side (``supported``), on the
+#: opposite side (``not supported``), inside the claim's equivalence margin ±m so that any
+#: difference is smaller than m (``equivalent``), or none of these (``inconclusive``)
+VERDICTS = ("supported", "not supported", "equivalent", "inconclusive")
+
+#: verdicts of a paper statement with several pieces of evidence: a claim verdict, or
+#: ``mixed`` when its pieces of evidence disagree (:mod:`rsmhp.claims.paper`)
+STATEMENT_VERDICTS = (*VERDICTS, "mixed")
+
+#: the two parts of the ledger: ``paper`` (a statement of the paper tested on the paper's own
+#: setup) and ``beyond`` (claims the report derives itself, and tests on model variants)
+PARTS = ("paper", "beyond")
 
 #: how a claim's key number reproduces: ``bitwise`` (same code, config, package versions, BLAS
 #: and CPU flags give identical bits; elsewhere it agrees to rounding) or ``statistical``
@@ -75,10 +95,16 @@ class KeyNumber:
 
 @dataclass(frozen=True)
 class Claim:
-    """One claim: what is tested (``claim``, our words), what the paper states and where
-    (``paper``), the key number with its CI, the verdict, and the rule that gave it.
-    ``measured`` holds the supporting numbers (appendix), ``dropped`` names every problem or
-    cell left out of the evidence and why."""
+    """One claim: what is tested (``claim``, our words, with its scope), what the paper
+    states and where (``paper``), the key number with its CI, the verdict, and the rule that
+    gave it. ``measured`` holds the supporting numbers (appendix), ``dropped`` names every
+    problem or cell left out of the evidence and why.
+
+    ``part`` is one of :data:`PARTS`; ``setup`` names the model and setting the claim was
+    tested on (the paper's, or a named variant); which statement of the paper a claim is
+    evidence for is said once, in :data:`rsmhp.claims.paper.STATEMENTS`. ``contrary`` names
+    every cell or setting whose CI lies on the side opposite to the claim (printed next to
+    the claim in the main text)."""
 
     id: str
     claim: str
@@ -88,12 +114,19 @@ class Claim:
     rule: str
     measured: str = ""
     dropped: str = ""
+    part: str = "paper"
+    setup: str = "paper"
+    contrary: str = ""
 
     def __post_init__(self) -> None:
         if self.verdict not in VERDICTS:
             raise ValueError(f"verdict must be one of {VERDICTS}, got {self.verdict!r}")
         if not self.rule.strip():
             raise ValueError(f"claim {self.id}: the verdict rule is missing")
+        if self.part not in PARTS:
+            raise ValueError(f"claim {self.id}: part must be one of {PARTS}, got {self.part!r}")
+        if not self.setup.strip():
+            raise ValueError(f"claim {self.id}: the setup it was tested on is missing")
         k = self.key
         if self.verdict == "supported" and k.null is not None and k.has_ci:
             if k.ci_low <= k.null <= k.ci_high:

@@ -23,9 +23,9 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 
-from rsmhp.ledger import VERDICTS
+from rsmhp.ledger import STATEMENT_VERDICTS
 
-__all__ = ["Case", "Rule", "at_most", "ci_side"]
+__all__ = ["Case", "Facts", "Rule", "at_most", "ci_side"]
 
 Facts = Mapping[str, float]
 
@@ -39,8 +39,10 @@ class Case:
     test: Callable[[Facts], bool]
 
     def __post_init__(self) -> None:
-        if self.verdict not in VERDICTS:
-            raise ValueError(f"Case.verdict must be one of {VERDICTS}, got {self.verdict!r}")
+        if self.verdict not in STATEMENT_VERDICTS:
+            raise ValueError(
+                f"Case.verdict must be one of {STATEMENT_VERDICTS}, got {self.verdict!r}"
+            )
         if not self.when.strip():
             raise ValueError("Case.when must say the condition in words, got ''")
 
@@ -57,8 +59,16 @@ class Rule:
     def __post_init__(self) -> None:
         if not self.cases:
             raise ValueError("Rule.cases must hold at least one Case")
-        if self.otherwise not in VERDICTS:
-            raise ValueError(f"Rule.otherwise must be one of {VERDICTS}, got {self.otherwise!r}")
+        if self.otherwise not in STATEMENT_VERDICTS:
+            raise ValueError(
+                f"Rule.otherwise must be one of {STATEMENT_VERDICTS}, got {self.otherwise!r}"
+            )
+
+    @property
+    def verdicts(self) -> tuple[str, ...]:
+        """Every verdict the rule can give (its cases' and ``otherwise``), in order."""
+        out = [c.verdict for c in self.cases] + [self.otherwise]
+        return tuple(dict.fromkeys(out))
 
     def verdict(self, facts: Facts) -> str:
         """The verdict of the first case whose condition holds, else ``otherwise``."""
@@ -91,13 +101,23 @@ def ci_side(
     claimed: str,
     null_text: str | None = None,
     basis: str = "",
+    margin: float | None = None,
+    margin_text: str | None = None,
 ) -> Rule:
     r"""The CI rule of paired differences: with facts ``<name>_low`` and ``<name>_high`` (the
     95% CI limits of ``name``), ``supported`` if the CI lies entirely on the ``claimed``
     side of ``null`` (``"below"`` or ``"above"``, strictly), ``not supported`` if it lies
-    entirely on the other side, ``inconclusive`` if it contains ``null``."""
+    entirely on the other side, ``inconclusive`` if it contains ``null``.
+
+    With an equivalence ``margin`` m > 0 (fixed before the run; ``margin_text`` prints it
+    with its unit), a first case gives ``equivalent`` when the CI lies strictly inside
+    :math:`(\text{null} - m, \text{null} + m)`: whatever the difference is, it is smaller
+    than m, so the claimed effect is absent at that resolution (even when the CI excludes
+    ``null``: a significant but negligible difference is not the claimed effect)."""
     if claimed not in ("below", "above"):
         raise ValueError(f"claimed must be 'below' or 'above', got {claimed!r}")
+    if margin is not None and not (isinstance(margin, int | float) and margin > 0):
+        raise ValueError(f"margin must be a number > 0 (or None), got {margin!r}")
     lo, hi = f"{name}_low", f"{name}_high"
     txt = null_text if null_text is not None else f"{null:g}"
 
@@ -109,11 +129,18 @@ def ci_side(
 
     first, second = (is_below, is_above) if claimed == "below" else (is_above, is_below)
     other = "above" if claimed == "below" else "below"
-    return Rule(
-        basis=basis,
-        cases=(
-            Case("supported", f"the 95% CI of {name} lies entirely {claimed} {txt}", first),
-            Case("not supported", f"it lies entirely {other} {txt}", second),
-        ),
-        otherwise="inconclusive",
-    )
+    cases = [
+        Case("supported", f"the 95% CI of {name} lies entirely {claimed} {txt}", first),
+        Case("not supported", f"it lies entirely {other} {txt}", second),
+    ]
+    if margin is not None:
+        m = float(margin)
+        mtxt = margin_text if margin_text is not None else f"{m:g}"
+
+        def inside(f: Facts) -> bool:
+            return null - m < f[lo] and f[hi] < null + m
+
+        around = f"{txt} ± {mtxt}" if null else f"±{mtxt}"
+        cases.insert(0, Case("equivalent", f"the 95% CI of {name} lies inside {around}", inside))
+        cases[1] = Case("supported", f"it lies entirely {claimed} {txt}", first)
+    return Rule(basis=basis, cases=tuple(cases), otherwise="inconclusive")

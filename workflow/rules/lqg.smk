@@ -11,6 +11,7 @@ LQG_SIM = {
     "model": pick(config["lqg"]["model"], "a", "x0", "r", "target", "sigma"),
     "convergence": pick(config["lqg"]["convergence"], "u", "P", "replicates"),
     "nbo_error": canonical(config["lqg"]["nbo_error"]),
+    "linear_cost": pick(config["lqg"]["linear_cost"], "H", "n", "replicates"),
 }
 
 
@@ -62,11 +63,34 @@ rule lqg_nbo_error:
         "../scripts/lqg_nbo_error.py"
 
 
+rule lqg_linear_cost:
+    """Prop. 3 on its own setting: Monte-Carlo estimates of a linear cost under linear dynamics, next to the paper's variance formula."""
+    output:
+        "results/lqg/linear_cost.csv",
+    log:
+        "results/logs/lqg_linear_cost.log",
+    benchmark:
+        "results/benchmarks/lqg_linear_cost.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        lqg={"linear_cost": LQG_SIM["linear_cost"]},
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/lqg_linear_cost.py"),
+    script:
+        "../scripts/lqg_linear_cost.py"
+
+
 rule lqg_summary:
     """LQG aggregation: per-P statistics, NBO-error summary, Markdown tables, report section."""
     input:
         convergence="results/lqg/convergence.csv",
         nbo_error="results/lqg/nbo_error.csv",
+        linear_cost="results/lqg/linear_cost.csv",
     output:
         summary="results/lqg/summary.csv",
         nbo_summary="results/lqg/nbo_error_summary.csv",
@@ -84,6 +108,7 @@ rule lqg_summary:
         runtime=5,
     params:
         eps=config["lqg"]["convergence"]["chebyshev_eps"],
+        linear_k=config["lqg"]["linear_cost"]["k"],
         # the inputs are checked against what the simulations were asked for
         lqg=LQG_SIM,
         code=code_digest("workflow/scripts/lqg_summary.py"),

@@ -39,5 +39,7 @@ with rule_logging(snakemake):
     write_csv(groups, snakemake.output.map_groups)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
-    section = narrative.uav_decision_section(regret, summary, map_df, groups, tables, cfg, seed)
+    section = narrative.uav_decision_section(
+        regret, summary, map_df, groups, tables, cfg, seed, snakemake.params.base_limited
+    )
     section.save(snakemake.output.section)

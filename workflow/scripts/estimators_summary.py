@@ -17,8 +17,9 @@ with rule_logging(snakemake):
         {"problems": snakemake.params.problems}, snakemake.params.model
     )
     summary = analysis.summarize_ablation(df, problems, snakemake.params.seed)
-    tables = narrative.tables(df, summary, ks)
+    cheb = analysis.chebyshev_table(df, summary, ks, problems)
+    tables = narrative.tables(df, summary, cheb)
     write_csv(summary, snakemake.output.summary)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
-    narrative.estimators_section(df, summary, ks, tables).save(snakemake.output.section)
+    narrative.estimators_section(df, summary, cheb, tables).save(snakemake.output.section)

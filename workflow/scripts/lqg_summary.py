@@ -4,7 +4,11 @@ from pathlib import Path
 
 from rsmhp.analysis import lqg as analysis
 from rsmhp.contracts import read_checked
-from rsmhp.experiments.lqg import convergence_contract, nbo_error_contract
+from rsmhp.experiments.lqg import (
+    convergence_contract,
+    linear_cost_contract,
+    nbo_error_contract,
+)
 from rsmhp.io import write_csv, write_text
 from rsmhp.narrative import lqg as narrative
 from rsmhp.pipeline import rule_logging
@@ -14,6 +18,8 @@ with rule_logging(snakemake):
     sim = snakemake.params.lqg
     conv = read_checked(snakemake.input.convergence, convergence_contract(sim))
     nbo = read_checked(snakemake.input.nbo_error, nbo_error_contract(sim))
+    linear = read_checked(snakemake.input.linear_cost, linear_cost_contract(sim))
+    linear_check = analysis.linear_cost_check(linear, snakemake.params.linear_k)
     summary = analysis.summarize_convergence(conv, eps)
     nbo_summary = analysis.summarize_nbo_error(nbo)
     tables = narrative.lqg_tables(summary, nbo_summary, eps)
@@ -21,4 +27,5 @@ with rule_logging(snakemake):
     write_csv(nbo_summary, snakemake.output.nbo_summary)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
-    narrative.lqg_section(summary, nbo_summary, conv, eps, tables).save(snakemake.output.section)
+    section = narrative.lqg_section(summary, nbo_summary, conv, eps, tables, linear_check)
+    section.save(snakemake.output.section)

@@ -6,11 +6,12 @@ import json
 import shutil
 from pathlib import Path
 
+from rsmhp.claims.paper import judge_all
 from rsmhp.io import write_text
 from rsmhp.ledger import Section, claims_records
 from rsmhp.pipeline import rule_logging
 from rsmhp.provenance import code_provenance, provenance
-from rsmhp.report import glance_table, render_appendix, render_report
+from rsmhp.report import glance_table, render_appendix, render_report, statements_records
 
 with rule_logging(snakemake) as log:
     sections = [Section.load(p) for p in snakemake.input.sections]
@@ -36,14 +37,15 @@ with rule_logging(snakemake) as log:
         render_appendix(sections, snakemake.params.config, summary), snakemake.output.appendix
     )
     records = claims_records(sections)
+    claims = [c for s in sorted(sections, key=lambda s: (s.order, s.key)) for c in s.claims]
     claims_file = {
         "config sha256": prov.get("config sha256"),
         "commit": prov.get("commit"),
+        "statements": statements_records(judge_all(claims)[0]),
         "claims": records,
     }
     write_text(
         json.dumps(claims_file, indent=1, ensure_ascii=False) + "\n", snakemake.output.claims
     )
-    claims = [c for s in sorted(sections, key=lambda s: (s.order, s.key)) for c in s.claims]
     write_text(glance_table(claims) + "\n", snakemake.output.glance)
     log.info("main text %d bytes, %d claims", len(main.encode()), len(records))

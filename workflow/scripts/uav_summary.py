@@ -21,6 +21,12 @@ with rule_logging(snakemake):
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
     section = narrative.uav_section(
-        summary, paired, tables, snakemake.params.setting, an["bootstrap"], runs
+        summary,
+        paired,
+        tables,
+        snakemake.params.setting,
+        an["bootstrap"],
+        runs,
+        an["equivalence_margin"],
     )
     section.save(snakemake.output.section)

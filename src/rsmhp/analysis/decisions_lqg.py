@@ -15,9 +15,10 @@ family of m z-scores is checked against the Bonferroni limit :math:`\Phi^{-1}(1 
 Closed forms (all derived in :mod:`rsmhp.lqg`): nbo, antithetic and cubature 0 (exact);
 mc with uniform weights :math:`\kappa v_H / P`; the shared-draw tree with uniform weights
 :math:`\kappa v_H / N`; mc with likeliness weights, to first order in 1/P,
-:math:`\kappa v_H (4/3)^{H/2}/(3P)`. Here :math:`\kappa = r^2 a^2 |c|^2 / (1 + r a^2 |c|^2)`,
-:math:`c_k = (1-a)^{H-1-k}` and :math:`v_H = \sigma^2 |c|^2` is the variance of the final
-state.
+:math:`\kappa v_H (4/3)^{H/2}/(3P)`. Here
+:math:`\kappa = r^2 a^2 \|\beta\|^2 / (1 + r a^2 \|\beta\|^2)`,
+:math:`\beta_k = (1-a)^{H-1-k}` and :math:`v_H = \sigma^2 \|\beta\|^2` is the variance of the
+final state.
 
 Slopes: OLS fit :math:`\log \bar\rho = c + s \log x` per (a, H, method, weighting) with
 :math:`x = P` (tree: N; pruned: M = P) and a t-interval for :math:`s`
@@ -50,6 +51,7 @@ __all__ = [
     "independent_regret",
     "lqg_scaling",
     "max_rel_regret",
+    "pruned_shape",
     "slopes",
     "summarize_lqg_regret",
     "z_families",
@@ -255,3 +257,44 @@ def independent_regret(cell: pd.Series, model: Mapping[str, Any]) -> float:
         r=float(model["r"]),
         sigma=float(model["sigma"]),
     )
+
+
+#: columns of :func:`pruned_shape`
+SHAPE_COLUMNS = [
+    "a", "H", "N", "n_M", "M_first", "mean_first", "low_first", "high_first",
+    "M_best", "mean_best", "low_best", "high_best", "M_last", "mean_last", "low_last",
+    "high_last", "falls", "rises", "tree_mean",
+]  # fmt: skip
+
+
+def pruned_shape(summary: pd.DataFrame) -> pd.DataFrame:
+    r"""The shape of the pruned tree's mean regret in M (N fixed), one row per (a, H) cell
+    with at least 3 values of M: the regret (mean, 95% CI) at the smallest M, at the M with
+    the lowest mean (``best``) and at the largest M; ``falls`` if the CIs at the largest and
+    at the smallest M do not overlap with the largest below, ``rises`` if the CI at the largest
+    M lies entirely above the CI at the best M (more kept trajectories decide significantly
+    worse than fewer: a U shape); ``tree_mean`` the mean regret of the unpruned shared-draw
+    tree with the same N in that cell (NaN if it was not run)."""
+    pr = summary[(summary["method"] == "pruned") & (summary["weighting"] == "uniform")]
+    tree = summary[(summary["method"] == "tree") & (summary["weighting"] == "uniform")]
+    rows = []
+    for (a, H), g in pr.groupby(["a", "H"], sort=True):
+        g = g.sort_values("M")
+        if len(g) < 3:
+            continue
+        first, last = g.iloc[0], g.iloc[-1]
+        best = g.loc[g["mean"].idxmin()]
+        n = int(g["N"].iloc[0])
+        t = tree[(tree["a"] == a) & (tree["H"] == H) & (tree["N"] == n)]
+        rows.append(
+            {
+                "a": a, "H": int(H), "N": n, "n_M": len(g),
+                **{f"{k}_{tag}": r[c] for tag, r in (("first", first), ("best", best),
+                   ("last", last)) for k, c in (("M", "M"), ("mean", "mean"),
+                   ("low", "ci_low"), ("high", "ci_high"))},
+                "falls": bool(last["ci_high"] < first["ci_low"]),
+                "rises": bool(last["ci_low"] > best["ci_high"]),
+                "tree_mean": float(t["mean"].iloc[0]) if len(t) else float("nan"),
+            }
+        )  # fmt: skip
+    return pd.DataFrame(rows, columns=SHAPE_COLUMNS)

@@ -35,10 +35,11 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from rsmhp.analysis.lqg import DETECTABLE_GRID
 from rsmhp.experiments.estimators import ABLATION_COLUMNS, build_problem
 from rsmhp.linear_quadratic import LinearQuadratic
 from rsmhp.seeding import job_rng
-from rsmhp.stats import SlopeFit, binomial_ci, loglog_slope
+from rsmhp.stats import SlopeFit, binomial_ci, detectable_scale, loglog_slope
 
 __all__ = [
     "CELL",
@@ -287,16 +288,30 @@ def equal_cpu_gains(s: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def chebyshev_table(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> pd.DataFrame:
-    """Plain MC: frequency of |J_n - J| >= k sd_n (sd from the closed form) vs 1/k², with its
-    Clopper-Pearson 95% interval."""
+def chebyshev_table(
+    df: pd.DataFrame,
+    s: pd.DataFrame,
+    ks: Sequence[float],
+    problems: Mapping[str, LinearQuadratic],
+) -> pd.DataFrame:
+    r"""Plain MC: frequency of :math:`|J_n - J| \ge k\,\mathrm{sd}_n` (sd from the closed
+    form) with its Clopper-Pearson 95% interval, against Chebyshev's bound :math:`1/k^2`
+    (``bound``) and the exact probability of that event (``exact``: :math:`J_n` is the mean
+    of n copies of the quadratic trajectory cost,
+    :meth:`~rsmhp.linear_quadratic.QuadraticForm.mean_error_tail`); ``detectable``: the
+    smallest relative spread error the cell's test detects with 80% power
+    (:func:`rsmhp.stats.detectable_scale`); ``replicates`` per cell."""
     rows = []
     mc = df[(df["scheme"] == "mc") & (df["weighting"] == "uniform")]
     theory = select(s, "mc").set_index(["problem", "n_trajectories"])["var_theory"]
-    for (problem, n), grp in mc.groupby(["problem", "n_trajectories"], sort=False):
+    groups = list(mc.groupby(["problem", "n_trajectories"], sort=False))
+    cells = len(groups) * len(ks)
+    for (problem, n), grp in groups:
         sd = float(np.sqrt(theory.loc[(problem, n)]))
+        form = problems[problem].quadratic_form
         err = np.abs(grp["estimate"].to_numpy() - grp["J_exact"].to_numpy())
-        for k in ks:
+        exact = np.atleast_1d(form.mean_error_tail(int(n), sd * np.asarray(ks, dtype=float)))
+        for k, p_exact in zip(ks, exact, strict=True):
             hits = int(np.sum(err >= k * sd))
             lo, hi = binomial_ci(hits, err.size)
             rows.append(
@@ -304,7 +319,17 @@ def chebyshev_table(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> p
                     "problem": problem,
                     "n": int(n),
                     "k": float(k),
+                    "replicates": int(err.size),
+                    "hits": hits,
                     "bound": min(1.0, 1 / k**2),
+                    "exact": float(p_exact),
+                    "detectable": detectable_scale(
+                        lambda x, n=int(n), form=form: form.mean_error_tail(n, x),
+                        float(k * sd),
+                        err.size,
+                        cells,
+                        grid=DETECTABLE_GRID,
+                    ),
                     "freq": hits / err.size,
                     "low": lo,
                     "high": hi,

@@ -31,12 +31,26 @@ import pandas as pd
 from scipy import stats as sps
 
 from rsmhp import lqg
-from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, NBO_ERROR_COLUMNS
-from rsmhp.stats import SlopeFit, binomial_ci, loglog_slope, mean_ci, rmse_ci
+from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, LINEAR_COST_COLUMNS, NBO_ERROR_COLUMNS
+from rsmhp.linear_quadratic import LinearCost, LinearQuadratic
+from rsmhp.stats import (
+    ExceedanceTest,
+    SlopeFit,
+    binomial_ci,
+    detectable_scale,
+    exceedance_test,
+    loglog_slope,
+    mean_ci,
+    rmse_ci,
+)
+
+#: relative spread errors searched for the power of the exceedance test (1% steps to 50%)
+DETECTABLE_GRID = np.round(np.arange(0.01, 0.5001, 0.01), 2)
 
 __all__ = [
     "ChebyshevCheck",
     "Fig3Check",
+    "LinearCostCheck",
     "NboErrorCheck",
     "PaperSettingCheck",
     "WeightedCheck",
@@ -44,6 +58,7 @@ __all__ = [
     "chebyshev_long",
     "eps_label",
     "fig3_check",
+    "linear_cost_check",
     "model_from_table",
     "nbo_error_check",
     "nbo_z_limit",
@@ -110,7 +125,12 @@ def summarize_convergence(df: pd.DataFrame, eps_values: Sequence[float]) -> pd.D
     weighted_limit`` and, per eps, ``bound_eps<e>`` (Chebyshev
     :math:`\min\{1, \mathrm{Var}(g)/(P\epsilon^2)\}`), ``exceed_eps<e>`` (observed frequency
     of :math:`|J_P - J| \ge \epsilon`) and its Clopper-Pearson 95% limits
-    ``exceed_low_eps<e>``/``exceed_high_eps<e>``. ``sd_theory`` is
+    ``exceed_low_eps<e>``/``exceed_high_eps<e>``, ``exact_eps<e>`` (the exact probability
+    of :math:`|J_P - J| \ge \epsilon`: :math:`J_P` is the mean of P copies of the quadratic
+    form g of the noise, a generalised chi-square,
+    :meth:`~rsmhp.linear_quadratic.QuadraticForm.mean_error_tail`) and ``detectable_eps<e>``
+    (the smallest relative error of the spread of :math:`J_P - J` the cell's exceedance test
+    detects with 80% power, :func:`rsmhp.stats.detectable_scale`). ``sd_theory`` is
     :math:`\sqrt{\mathrm{Var}(g)/P}`.
     """
     missing = [c for c in CONVERGENCE_COLUMNS if c not in df.columns]
@@ -118,15 +138,26 @@ def summarize_convergence(df: pd.DataFrame, eps_values: Sequence[float]) -> pd.D
         raise ValueError(f"convergence table lacks columns {missing}")
     u, model = model_from_table(df)
     kw = model.closed_form_args()
+    form = LinearQuadratic.from_lqg(model, u).quadratic_form
+    cells = df["P"].nunique() * len(eps_values)
     rows = []
     for P, grp in df.groupby("P", sort=True):
         est = grp["J_mhp"].to_numpy()
         row = _convergence_row(int(P), est, grp["J_mhp_weighted"].to_numpy(), u, model)
-        for eps in eps_values:
+        exact = np.atleast_1d(form.mean_error_tail(int(P), np.asarray(eps_values, dtype=float)))
+        for eps, p_exact in zip(eps_values, exact, strict=True):
             k = int(np.sum(np.abs(est - row["J_exact"]) >= eps))
             flo, fhi = binomial_ci(k, est.size)
             e = eps_label(eps)
             row[f"bound_eps{e}"] = lqg.chebyshev_bound(int(P), eps, u, **kw)
+            row[f"exact_eps{e}"] = float(p_exact)
+            row[f"detectable_eps{e}"] = detectable_scale(
+                lambda x, P=int(P): form.mean_error_tail(P, x),
+                float(eps),
+                est.size,
+                cells,
+                grid=DETECTABLE_GRID,
+            )
             row[f"exceed_eps{e}"] = k / est.size
             row[f"exceed_low_eps{e}"] = flo
             row[f"exceed_high_eps{e}"] = fhi
@@ -136,7 +167,8 @@ def summarize_convergence(df: pd.DataFrame, eps_values: Sequence[float]) -> pd.D
 
 def chebyshev_long(summary: pd.DataFrame, eps_values: Sequence[float]) -> pd.DataFrame:
     r"""Long format of the Chebyshev columns, one row per (P, ε): ``P, eps, n`` (replicates),
-    ``k`` (exceedances), ``bound`` (capped at 1), ``bound_raw``
+    ``k`` (exceedances), ``bound`` (capped at 1), ``exact`` (exact probability),
+    ``detectable`` (see :func:`summarize_convergence`), ``bound_raw``
     (:math:`\mathrm{Var}(g)/(P\epsilon^2)`, uncapped), ``freq = k/n`` and its 95%
     Clopper-Pearson limits ``low``, ``high``."""
     parts = []
@@ -152,6 +184,8 @@ def chebyshev_long(summary: pd.DataFrame, eps_values: Sequence[float]) -> pd.Dat
                     "k": np.rint(summary[f"exceed_eps{e}"] * n).astype(int),
                     "bound": summary[f"bound_eps{e}"],
                     "bound_raw": summary["sd_theory"] ** 2 / float(eps) ** 2,
+                    "exact": summary[f"exact_eps{e}"],
+                    "detectable": summary[f"detectable_eps{e}"],
                     "freq": summary[f"exceed_eps{e}"],
                     "low": summary[f"exceed_low_eps{e}"],
                     "high": summary[f"exceed_high_eps{e}"],
@@ -327,54 +361,41 @@ def fig3_check(summary: pd.DataFrame) -> Fig3Check:
 
 @dataclass(frozen=True)
 class ChebyshevCheck:
-    r"""LQG-3's numbers over the (P, ε) cells. A cell is *informative* when its bound
-    :math:`\mathrm{Var}(g)/(P\epsilon^2) < 1`; ``n_significant`` counts the informative cells
-    whose Clopper-Pearson lower limit of the exceedance frequency at familywise level 95%
-    (Bonferroni over the informative cells) lies above the bound, ``n_significant_per_cell``
-    the same at level 95% per cell. ``max_ratio`` (largest frequency / bound) and its cell
-    ``worst_P``, ``worst_eps`` are ``None`` when no cell is informative."""
+    r"""LQG-3's numbers over the (P, ε) cells: ``test`` compares each cell's exceedance count
+    with the exact probability of :math:`|J_P - J| \ge \epsilon` and with Chebyshev's bound
+    (:func:`rsmhp.stats.exceedance_test`, familywise 95% over the cells); ``detectable`` is
+    the smallest relative error of the spread of :math:`J_P - J` that the most sensitive cell
+    detects with 80% power (``inf`` if none on the grid); ``worst_P``, ``worst_eps`` the cell
+    with the smallest adjusted p-value; ``n_informative`` the cells whose bound is below 1."""
 
-    n_cells: int
+    test: ExceedanceTest
+    detectable: float
+    worst_P: int
+    worst_eps: float
+    worst_freq: float
+    worst_exact: float
     n_informative: int
-    n_significant: int
-    n_significant_per_cell: int
-    max_ratio: float | None
-    worst_P: int | None
-    worst_eps: float | None
     replicates: int
 
     @property
-    def n_vacuous(self) -> int:
-        """Cells whose bound is at least 1 (no probability exceeds it)."""
-        return self.n_cells - self.n_informative
+    def n_cells(self) -> int:
+        return self.test.cells
 
 
 def chebyshev_check(summary: pd.DataFrame, eps_values: Sequence[float]) -> ChebyshevCheck:
     """:class:`ChebyshevCheck` of the per-P summary for the configured ``eps_values``."""
     cheb = chebyshev_long(summary, eps_values)
-    informative = cheb[cheb["bound_raw"] < 1]
-    n_inf = len(informative)
-    replicates = int(summary["n_replicates"].max())
-    if not n_inf:
-        return ChebyshevCheck(len(cheb), 0, 0, 0, None, None, None, replicates)
-    level = 1 - 0.05 / n_inf
-    low_fw = np.array(
-        [
-            binomial_ci(int(k), int(n), level)[0]
-            for k, n in zip(informative["k"], informative["n"], strict=True)
-        ]
-    )
-    ratio = informative["freq"] / informative["bound"]
-    worst = informative.iloc[int(np.argmax(ratio))]
+    test = exceedance_test(cheb["k"], cheb["n"], cheb["exact"], cheb["bound"])
+    worst = cheb.iloc[test.worst]
     return ChebyshevCheck(
-        n_cells=len(cheb),
-        n_informative=n_inf,
-        n_significant=int(np.sum(low_fw > informative["bound"].to_numpy())),
-        n_significant_per_cell=int(np.sum(informative["low"] > informative["bound"])),
-        max_ratio=float(ratio.max()),
+        test=test,
+        detectable=float(cheb["detectable"].min()),
         worst_P=int(worst["P"]),
         worst_eps=float(worst["eps"]),
-        replicates=replicates,
+        worst_freq=float(worst["freq"]),
+        worst_exact=float(worst["exact"]),
+        n_informative=int((cheb["bound_raw"] < 1).sum()),
+        replicates=int(summary["n_replicates"].max()),
     )
 
 
@@ -412,4 +433,73 @@ def weighted_check(summary: pd.DataFrame) -> WeightedCheck:
         J=float(last["J_exact"]),
         limit=float(last["weighted_limit"]),
         replicates=int(last["n_replicates"]),
+    )
+
+
+@dataclass(frozen=True)
+class LinearCostCheck:
+    r"""Prop. 3 on its own setting (:func:`rsmhp.experiments.lqg.run_linear_cost`). Per n:
+    the sample variance :math:`s_n^2` of the R estimates :math:`J_n` against the paper's
+    :math:`\mathrm{Var}(p)/n`; :math:`J_n` is exactly Gaussian, so :math:`(R-1)s_n^2 n /
+    \mathrm{Var}(p) \sim \chi^2_{R-1}` and :math:`z_n = (s_n^2 n/\mathrm{Var}(p) - 1)/
+    \sqrt{2/(R-1)}` is standard normal to within :math:`O(R^{-1/2})`; ``pooled_z`` sums the
+    independent chi-squares over n. The means give :math:`z = (\bar J_n - J)/
+    \sqrt{\mathrm{Var}(p)/(nR)}`. ``z_limit``: Bonferroni limit (two-sided, familywise 95%)
+    over the ``2 len(n) + 1`` z tests. ``exceedance``: counts of :math:`|J_n - J| \ge k\,
+    \mathrm{sd}_n` against the exact probability :math:`2\Phi(-k)` and Chebyshev's
+    :math:`1/k^2`. ``var_prop3`` the paper's formula, ``var_form`` the same variance derived
+    independently from the cost's quadratic form (they agree to rounding)."""
+
+    n: tuple[int, ...]
+    var_z: tuple[float, ...]
+    mean_z: tuple[float, ...]
+    pooled_z: float
+    z_limit: float
+    exceedance: ExceedanceTest
+    var_prop3: float
+    var_form: float
+    replicates: int
+    H: int
+
+    @property
+    def max_abs_z(self) -> float:
+        return float(max(np.abs([*self.var_z, *self.mean_z, self.pooled_z])))
+
+
+def linear_cost_check(df: pd.DataFrame, ks: Sequence[float]) -> LinearCostCheck:
+    """:class:`LinearCostCheck` of ``results/lqg/linear_cost.csv`` for the multipliers ``ks``."""
+    missing = [c for c in LINEAR_COST_COLUMNS if c not in df.columns]
+    if missing:
+        raise ValueError(f"linear-cost table lacks columns {missing}")
+    H = int(df["H"].iloc[0])
+    system = LinearCost.example(H)
+    var, J = system.prop3_variance(), system.exact_cost()
+    form = system.quadratic_form
+    ns, var_z, mean_z, cells = [], [], [], []
+    chi, dof = 0.0, 0
+    for n, g in df.groupby("n", sort=True):
+        est = g["estimate"].to_numpy(float)
+        R, sd_n = est.size, float(np.sqrt(var / n))
+        ratio = float(est.var(ddof=1)) / sd_n**2
+        ns.append(int(n))
+        var_z.append((ratio - 1.0) / np.sqrt(2.0 / (R - 1)))
+        mean_z.append((float(est.mean()) - J) / (sd_n / np.sqrt(R)))
+        chi, dof = chi + (R - 1) * ratio, dof + (R - 1)
+        exact = np.atleast_1d(form.mean_error_tail(int(n), sd_n * np.asarray(ks, dtype=float)))
+        for k, p_exact in zip(ks, exact, strict=True):
+            hits = int(np.sum(np.abs(est - J) >= k * sd_n))
+            cells.append((hits, R, float(p_exact), min(1.0, 1.0 / float(k) ** 2)))
+    k_arr, n_arr, p_arr, b_arr = (np.array(c) for c in zip(*cells, strict=True))
+    m = 2 * len(ns) + 1
+    return LinearCostCheck(
+        n=tuple(ns),
+        var_z=tuple(float(z) for z in var_z),
+        mean_z=tuple(float(z) for z in mean_z),
+        pooled_z=float((chi - dof) / np.sqrt(2.0 * dof)),
+        z_limit=float(sps.norm.ppf(1 - 0.025 / m)),
+        exceedance=exceedance_test(k_arr, n_arr, p_arr, b_arr),
+        var_prop3=var,
+        var_form=form.variance(),
+        replicates=int(df.groupby("n").size().min()),
+        H=H,
     )

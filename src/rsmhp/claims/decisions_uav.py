@@ -3,23 +3,24 @@ r"""Decision study on the UAV, claims DEC-6, DEC-7-<model>, DEC-8a/b: each a key
 facts; the rule's printed text and its evaluation are one object. Every key number is
 statistical (closed loop, optimiser).
 
-* **DEC-6** (equivalence, :data:`DEC6_RULE`): d = relative regret of NBO − that of RS-MHP
-  (:class:`MonteCarlo`) with the largest N_T, paired per belief state of the reconstruction,
-  in percentage points (pp). *supported* if the 95% bootstrap CI of mean d lies inside
-  :math:`\pm` :data:`EQUIVALENCE_MARGIN` (0.5 pp, fixed before the run), *not supported* if it
-  lies entirely outside, *inconclusive* otherwise.
-* **DEC-7-<model>** (:data:`DEC7_RULE`): the same d on each model variant; *supported* if the
-  CI lies above 0, *not supported* if below 0, *inconclusive* otherwise.
+* **DEC-6** (the reconstruction, part "paper") and **DEC-7-<model>** (each model variant,
+  part "beyond"), both by :func:`regret_rule`: d = relative regret of NBO − that of RS-MHP
+  (:class:`MonteCarlo`) with the largest N_T, paired per belief state, in percentage points
+  (pp). *equivalent* if the 95% bootstrap CI of mean d lies inside ±m (m fixed in the config
+  before the run, ``decisions.claims.equivalence_margin_pp``), else *supported* if it lies
+  above 0, *not supported* if below 0, *inconclusive* otherwise.
 * **DEC-8a/b** (:data:`DEC8_RULE`): d = closed-loop average location error of RS-MHP (the
-  first N_T of the map) − NBO, paired over runs, for the cells with (a) / without (b) a
-  footprint: *supported* if d's CI lies below 0 in every cell of the group and for d averaged
-  over its cells, *not supported* if above 0 in some cell or on average, *inconclusive*
-  otherwise.
+  map method fixed in the config, ``decisions.claims.map_method``) − NBO, paired over runs,
+  for the cells with (a) / without (b) a footprint: *supported* if d's CI lies below 0 in
+  every cell of the group and for d averaged over its cells, *not supported* if above 0 in
+  some cell or on average, *inconclusive* otherwise. Every cell where some RS-MHP member of
+  the map is significantly worse than NBO is named as contrary evidence.
 """
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -28,31 +29,29 @@ from rsmhp.analysis.decisions_uav import (
     axis_label,
     base_model,
     largest_rsmhp,
+    limited_cells,
     optimiser_share,
     paired_regret,
 )
 from rsmhp.analysis.uav import baseline_name, is_family
 from rsmhp.ledger import Claim, KeyNumber
-from rsmhp.markdown import fmt, param_text, range_text
+from rsmhp.markdown import fmt, fmt_ci, param_text, range_text
 from rsmhp.palette import method_label
 from rsmhp.uav.methods.monte_carlo import MonteCarlo
 from rsmhp.verdicts import Case, Facts, Rule, ci_side
 
 __all__ = [
-    "DEC6_RULE",
-    "DEC7_RULE",
     "DEC8_RULE",
-    "EQUIVALENCE_MARGIN",
     "KEY",
     "ci_facts",
     "map_comparison",
+    "map_contrary",
     "map_facts",
     "pp",
     "range_text",
+    "regret_rule",
     "uav_claims",
 ]
-
-EQUIVALENCE_MARGIN = 0.005  # DEC-6: 0.5 percentage points of relative regret, fixed a priori
 
 #: the key number of every claim here, as the rules name it (facts ``mean d_low/high``)
 KEY = "mean d"
@@ -64,36 +63,25 @@ def pp(x: float) -> float:
     return float(100.0 * x)
 
 
-_MARGIN = pp(EQUIVALENCE_MARGIN)
-_MARGIN_TEXT = f"±{param_text(_MARGIN)} percentage points"
 _REGRET_D = "d = relative regret of NBO − that of RS-MHP with the largest N_T, paired per belief"
 
-DEC6_RULE = Rule(
-    basis=f"{_REGRET_D} state of the reconstruction (pp)",
-    cases=(
-        Case(
-            "supported",
-            f"the 95% bootstrap CI of {KEY} lies inside {_MARGIN_TEXT} (equivalent)",
-            lambda f: -_MARGIN < f[_LO] and f[_HI] < _MARGIN,
-        ),
-        Case(
-            "not supported",
-            "it lies entirely outside that margin",
-            lambda f: f[_LO] >= _MARGIN or f[_HI] <= -_MARGIN,
-        ),
-    ),
-    otherwise="inconclusive",
-)
 
-DEC7_RULE = ci_side(
-    KEY,
-    0.0,
-    claimed="above",
-    basis=f"{_REGRET_D} state of the model variant (pp); 95% bootstrap CI",
-)
+def regret_rule(margin_pp: float, setting: str) -> Rule:
+    """The rule of DEC-6 (``setting`` "the reconstruction") and DEC-7 (a model variant):
+    RS-MHP decides better than NBO, with the equivalence margin ±``margin_pp``."""
+    return ci_side(
+        KEY,
+        0.0,
+        claimed="above",
+        basis=f"{_REGRET_D} state of {setting} (pp); 95% bootstrap CI",
+        margin=margin_pp,
+        margin_text=f"{param_text(margin_pp)} pp",
+    )
+
 
 DEC8_RULE = Rule(
-    basis="d = closed-loop average location error of RS-MHP (first N_T of the map) − NBO, "
+    basis="d = closed-loop average location error of the RS-MHP member of the map fixed in "
+    "the config (decisions.claims.map_method) − NBO, "
     "paired over runs; 95% bootstrap CIs",
     cases=(
         Case(
@@ -112,7 +100,7 @@ DEC8_RULE = Rule(
 
 
 def ci_facts(key: KeyNumber) -> Facts:
-    """The CI of a key number as the facts of :data:`DEC6_RULE` and :data:`DEC7_RULE`."""
+    """The CI of a key number as the facts of :func:`regret_rule`."""
     return {_LO: float(key.ci_low), _HI: float(key.ci_high)}
 
 
@@ -127,9 +115,9 @@ def map_facts(group: pd.Series) -> Facts:
     }
 
 
-def _regret_key(method: str, m: float, lo: float, hi: float, null: float | None) -> KeyNumber:
+def _regret_key(method: str, m: float, lo: float, hi: float) -> KeyNumber:
     """Key number of DEC-6/DEC-7: paired mean of NBO's − ``method``'s relative regret (pp)
-    with its bootstrap CI; ``null`` 0 for a difference claim, None for equivalence."""
+    with its bootstrap CI."""
     return KeyNumber(
         f"NBO − {method_label(method)} relative regret, paired mean",
         pp(m),
@@ -138,19 +126,32 @@ def _regret_key(method: str, m: float, lo: float, hi: float, null: float | None)
         unit="pp",
         reproducible="statistical",
         digits=2,
-        null=null,
+        null=0.0,
+    )
+
+
+def _margin_note(margin_pp: float, share: float) -> str:
+    return (
+        f"margin ±{param_text(margin_pp)} pp fixed in the config (decisions.claims); the "
+        f"optimiser alone leaves every method {fmt(pp(share), 3)}% above the best plan found"
     )
 
 
 def _dec6(
-    regret: pd.DataFrame, summary: pd.DataFrame, base: str, best_rs: str, seed: int, n_boot: int
+    regret: pd.DataFrame,
+    summary: pd.DataFrame,
+    base: str,
+    best_rs: str,
+    margin_pp: float,
+    seed: int,
+    n_boot: int,
 ) -> Claim | None:
     nbo = summary[(summary["model"] == base) & (summary["method"] == baseline_name())]
     if nbo.empty:
         return None
     r = nbo.iloc[0]
     d = paired_regret(regret, base, best_rs, seed, n_boot)
-    key = _regret_key(best_rs, d.mean, d.low, d.high, null=None)
+    key = _regret_key(best_rs, d.mean, d.low, d.high)
     sp = r["spearman_random"]
     sp_txt = (
         f"; Spearman rank correlation of NBO's cost with the evaluation cost over random "
@@ -158,62 +159,111 @@ def _dec6(
         if np.isfinite(sp)
         else ""
     )
+    rule = regret_rule(margin_pp, "the reconstruction")
     return Claim(
         "DEC-6",
-        f"Reconstruction ('{base}'): NBO decides as well as {method_label(best_rs)} "
-        f"(relative regrets within ±{param_text(_MARGIN)} pp)",
-        "Not in the paper; explains why the closed-loop comparisons (Fig. 5, UAV "
-        "claims) cannot separate the methods",
+        f"On the UAV reconstruction, {method_label(best_rs)} chooses better plans than NBO "
+        "(lower open-loop relative regret)",
+        "Sec. II: NBO may generate severely sub-optimal controls (tested here on open-loop "
+        "plans of the paper's UAV setup)",
         key,
-        DEC6_RULE.verdict(ci_facts(key)),
-        DEC6_RULE.text(),
+        rule.verdict(ci_facts(key)),
+        rule.text(),
         measured=f"{d.n} belief states; NBO's mean relative regret "
         f"{fmt(pp(r['mean_regret_rel']))}%, of which "
         f"{fmt(pp(r['mean_regret_methods_rel']), 2)} pp against the best method's "
-        f"plan: every method shares {fmt(pp(optimiser_share(regret, base)), 3)}% "
-        "from the common optimiser budget (the multi-start on the evaluation cost "
-        f"finds better plans){sp_txt}",
+        f"plan; {_margin_note(margin_pp, optimiser_share(regret, base))} (the multi-start on "
+        f"the evaluation cost finds better plans){sp_txt}",
+        part="paper",
+        setup=f"UAV reconstruction '{base}' (Sec. III-B), open-loop plans",
     )
 
 
 def _dec7(
-    regret: pd.DataFrame, summary: pd.DataFrame, model: str, best_rs: str, seed: int, n_boot: int
+    regret: pd.DataFrame,
+    summary: pd.DataFrame,
+    model: str,
+    best_rs: str,
+    margin_pp: float,
+    seed: int,
+    n_boot: int,
 ) -> Claim:
     d = paired_regret(regret, model, best_rs, seed, n_boot)
     in_model = summary[summary["model"] == model]
     s_nbo = in_model[in_model["method"] == baseline_name()].iloc[0]
     s_rs = in_model[in_model["method"] == best_rs].iloc[0]
-    key = _regret_key(best_rs, d.mean, d.low, d.high, null=0.0)
+    key = _regret_key(best_rs, d.mean, d.low, d.high)
+    rule = regret_rule(margin_pp, "the model variant")
     return Claim(
         f"DEC-7-{model}",
-        f"Model variant '{model}': {method_label(best_rs)} decides better than "
+        f"On the UAV variant '{model}', {method_label(best_rs)} chooses better plans than "
         "NBO (lower open-loop relative regret)",
         "Sec. II: NBO may generate severely sub-optimal controls; tested on a "
         "model variant (not the paper's model)",
         key,
-        DEC7_RULE.verdict(ci_facts(key)),
-        DEC7_RULE.text(),
+        rule.verdict(ci_facts(key)),
+        rule.text(),
         measured=f"{d.n} belief states; mean relative regret NBO "
         f"{fmt(pp(s_nbo['mean_regret_rel']))}% vs {method_label(best_rs)} "
         f"{fmt(pp(s_rs['mean_regret_rel']))}%; NBO's cost is constant over "
         f"random plans at {int(s_nbo['spearman_random_undefined'])} of "
-        f"{int(s_nbo['n_states'])} states",
+        f"{int(s_nbo['n_states'])} states; "
+        f"{_margin_note(margin_pp, optimiser_share(regret, model))}",
+        part="beyond",
+        setup=f"UAV variant '{model}', open-loop plans",
     )
 
 
-def map_comparison(map_df: pd.DataFrame) -> tuple[str, list[str]] | None:
-    """The map comparison DEC-8 rests on, the first with an RS-MHP method (the first N_T of
-    the map, fixed before the run), and the methods of the other comparisons; None if the
-    map has no RS-MHP comparison."""
+def map_comparison(map_df: pd.DataFrame, method: str = "") -> tuple[str, list[str]] | None:
+    """The map comparison DEC-8 rests on, ``"<method> − nbo"`` (``method`` fixed in the
+    config before the run, ``decisions.claims.map_method``; empty: the first RS-MHP member of
+    the map), and the methods of the other comparisons; None if the map has no RS-MHP
+    comparison. A configured method the map did not run is refused."""
     comps = list(dict.fromkeys(map_df["comparison"]))
-    methods = pd.Series([c.split(" − ")[0] for c in comps], dtype=object)
-    rs = [c for c, ok in zip(comps, is_family(methods, MonteCarlo), strict=True) if ok]
-    if not rs:
+    methods = [c.split(" − ")[0] for c in comps]
+    rs = [
+        c
+        for c, ok in zip(
+            comps, is_family(pd.Series(methods, dtype=object), MonteCarlo), strict=True
+        )
+        if ok
+    ]
+    if method:
+        if method not in methods:
+            raise ValueError(
+                f"decisions.claims.map_method = {method!r} is not a method of the map "
+                f"(allowed: {', '.join(methods)})"
+            )
+        chosen = comps[methods.index(method)]
+    elif rs:
+        chosen = rs[0]
+    else:
         return None
-    return rs[0], [c.split(" − ")[0] for c in comps if c != rs[0]]
+    return chosen, [m for c, m in zip(comps, methods, strict=True) if c != chosen]
 
 
-def _dec8_claim(cid: str, label: str, g: pd.Series, map_df: pd.DataFrame, others: str) -> Claim:
+def map_contrary(map_df: pd.DataFrame, limited: pd.Series, flag: bool) -> str:
+    """Every (cell, comparison) of the group (``limited == flag``) whose 95% CI of RS-MHP −
+    NBO lies above 0 (RS-MHP significantly worse), for every method of the map."""
+    rows = map_df[(limited == flag) & (map_df["ci_low"] > 0)]
+    return "; ".join(
+        f"{_cell_name(r)}: {method_label(r['comparison'].split(' − ')[0])} − NBO = "
+        f"{fmt(r['mean_diff'], 3, True)} {fmt_ci(r['ci_low'], r['ci_high'], 3, True)} m"
+        for _, r in rows.iterrows()
+    )
+
+
+def _cell_name(r: pd.Series) -> str:
+    def one(key: str, val: object) -> str:
+        unlimited = key == "sensor.footprint_radius" and pd.isna(val)
+        return f"{axis_label(key)} {'unlimited' if unlimited else param_text(float(val))}"
+
+    return f"{one(r['row_key'], r['row_value'])}, {one(r['col_key'], r['col_value'])}"
+
+
+def _dec8_claim(
+    cid: str, label: str, g: pd.Series, map_df: pd.DataFrame, others: str, contrary: str
+) -> Claim:
     method = g["comparison"].split(" − ")[0]
     n_cells = int(g["n_cells"])
     cells = range_text(pd.Series([g["cell_min"], g["cell_max"]]), 3, True)
@@ -247,21 +297,29 @@ def _dec8_claim(cid: str, label: str, g: pd.Series, map_df: pd.DataFrame, others
         f"{int(g['n_below'])} of {n_cells} cells, above 0 in {int(g['n_above'])}; "
         f"cell means {cells} m; track loss NBO "
         f"{fmt(pp(g['loss_nbo']), 2)}% vs {fmt(pp(g['loss_method']), 2)}%"
-        f"{regret_txt} (means over the cells)",
+        f"{regret_txt} (means over the cells); the compared method, {method_label(method)}, "
+        "is fixed in the config before the run (decisions.claims.map_method)",
         dropped=(
-            f"the map's other comparison ({others} − {baseline_name()}) is not used: the rule "
-            "fixes the first RS-MHP N_T of the map before the run (appendix table)"
+            f"the map's other comparisons ({others} − {baseline_name()}) are not the key "
+            "number; cells where one of them lies on the opposite side are named as contrary"
             if others
             else ""
         ),
+        part="beyond",
+        setup=f"UAV sensitivity map ({axis_label(row_key)} × {axis_label(col_key)}), "
+        + ("cells with a footprint" if cid == "DEC-8a" else "cells without a footprint"),
+        contrary=contrary,
     )
 
 
-def _dec8(map_df: pd.DataFrame, groups: pd.DataFrame) -> list[Claim]:
-    chosen = None if map_df.empty or groups.empty else map_comparison(map_df)
+def _dec8(
+    map_df: pd.DataFrame, groups: pd.DataFrame, method: str, base_limited: bool
+) -> list[Claim]:
+    chosen = None if map_df.empty or groups.empty else map_comparison(map_df, method)
     if chosen is None:
         return []
     comp, other_methods = chosen
+    limited = limited_cells(map_df, base_limited)
     claims = []
     for cid, flag, label in (
         ("DEC-8a", True, "With a limited sensor footprint"),
@@ -269,7 +327,9 @@ def _dec8(map_df: pd.DataFrame, groups: pd.DataFrame) -> list[Claim]:
     ):
         sel = groups[(groups["comparison"] == comp) & (groups["limited"] == flag)]
         if not sel.empty:
-            claims.append(_dec8_claim(cid, label, sel.iloc[0], map_df, ", ".join(other_methods)))
+            others = ", ".join(method_label(m) for m in other_methods)
+            contrary = map_contrary(map_df, limited, flag)
+            claims.append(_dec8_claim(cid, label, sel.iloc[0], map_df, others, contrary))
     return claims
 
 
@@ -278,17 +338,24 @@ def uav_claims(
     summary: pd.DataFrame,
     map_df: pd.DataFrame,
     groups: pd.DataFrame,
+    rules: Mapping[str, Any],
     seed: int,
     n_boot: int,
+    base_limited: bool = False,
 ) -> list[Claim]:
     """Claims DEC-6, DEC-7-<model>, DEC-8a/b (module doc); ``groups`` is
-    :func:`rsmhp.analysis.decisions_uav.summarize_map_groups`."""
+    :func:`rsmhp.analysis.decisions_uav.summarize_map_groups`, ``rules`` the
+    ``decisions.claims`` config (equivalence margin, the map method of DEC-8)."""
+    margin = float(rules["equivalence_margin_pp"])
     claims: list[Claim] = []
     models: Sequence[str] = list(dict.fromkeys(regret["model"]))
     best_rs = largest_rsmhp(summary)
     base = base_model(models)
     if best_rs is not None:
-        dec6 = _dec6(regret, summary, base, best_rs, seed, n_boot) if base is not None else None
-        claims += [dec6] if dec6 is not None else []
-        claims += [_dec7(regret, summary, m, best_rs, seed, n_boot) for m in models if m != base]
-    return claims + _dec8(map_df, groups)
+        if base is not None:
+            dec6 = _dec6(regret, summary, base, best_rs, margin, seed, n_boot)
+            claims += [dec6] if dec6 is not None else []
+        claims += [
+            _dec7(regret, summary, m, best_rs, margin, seed, n_boot) for m in models if m != base
+        ]
+    return claims + _dec8(map_df, groups, str(rules.get("map_method", "")), base_limited)

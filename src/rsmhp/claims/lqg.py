@@ -13,16 +13,19 @@ printed text and its evaluation come from the same :class:`~rsmhp.verdicts.Rule`
   the OLS fit :math:`\log \mathrm{RMSE} = c + s \log P` with its 95% CI (null 0).
   *supported* if the CI of :math:`s` lies below 0, at the largest P the upper 95% limit of
   the RMSE is below :math:`|J - J_{NBO}|` and the 95% CI of the mean :math:`J_P` contains
-  :math:`J`; *not supported* if the CI of :math:`s` lies at or above 0 or the lower 95% limit
-  of the RMSE at the largest P is at least :math:`|J - J_{NBO}|`; *inconclusive* otherwise
-  (:data:`FIG3_RULE`).
-* **LQG-3, Prop. 3** (Chebyshev bound :math:`P(|J_P - J| \ge \epsilon) \le
-  \mathrm{Var}(g)/(P\epsilon^2)`). Only cells with an informative bound
-  (:math:`\mathrm{Var}(g)/(P\epsilon^2) < 1`) carry evidence. Key number: the number of
-  informative cells whose Clopper-Pearson lower limit of the exceedance frequency, at
-  familywise level 95% (Bonferroni over the informative cells), lies above the bound.
-  *inconclusive* if no cell is informative, *supported* if it is 0, *not supported*
-  otherwise (:data:`CHEBYSHEV_RULE`).
+  :math:`J`; *not supported* if the CI of :math:`s` lies at or above 0, or at the largest P
+  the CI of the mean excludes J (a bias that does not vanish) or the RMSE's lower limit is at
+  least :math:`|J - J_{NBO}|`; *inconclusive* otherwise (:data:`FIG3_RULE`).
+* **LQG-3, Prop. 3** (:math:`P(|J_P - J| \ge \epsilon) \le \mathrm{Var}(g)/(P\epsilon^2)`).
+  :math:`J_P` is the mean of P copies of the quadratic trajectory cost, so the probability of
+  :math:`|J_P - J| \ge \epsilon` is known exactly (a generalised chi-square). Per (P, ε)
+  cell the exceedance count is tested against that exact probability (two-sided exact
+  binomial test, familywise 95%), which has power (the appendix states the spread error it
+  detects), and against Chebyshev's bound (familywise Clopper-Pearson lower limit). *not
+  supported* if some cell lies significantly above the bound; *supported* if no cell departs
+  from the exact probability and the exact probability is below the bound everywhere;
+  *inconclusive* otherwise (:func:`exceedance_rule`). Key number: the smallest
+  Bonferroni-adjusted p-value.
 * **LQG-4, Prop. 2 for non-overlapping samples** (the likeliness-weighted average converges
   to J). Key number: the weighted estimate at the largest P with its 95% CI. For Gaussian
   noise the weights tilt :math:`N(0, \sigma^2)` to :math:`N(0, \sigma^2/2)`, so the derived
@@ -36,11 +39,13 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+import numpy as np
 import pandas as pd
 
 from rsmhp.analysis.lqg import (
     ChebyshevCheck,
     Fig3Check,
+    LinearCostCheck,
     NboErrorCheck,
     WeightedCheck,
     chebyshev_check,
@@ -51,6 +56,7 @@ from rsmhp.analysis.lqg import (
 )
 from rsmhp.ledger import Claim, KeyNumber
 from rsmhp.markdown import fmt, fmt_ci
+from rsmhp.stats import ExceedanceTest
 from rsmhp.verdicts import Case, Facts, Rule, at_most
 
 __all__ = [
@@ -74,6 +80,9 @@ __all__ = [
 
 #: Sec. and figure of the paper this study replicates
 PAPER_FIG3 = "Sec. III-A, Fig. 3"
+
+#: the setup of LQG-1..4: the paper's oven model (Sec. III-A)
+SETUP = "oven LQG (Sec. III-A)"
 
 
 def fmt_exact(x: float, digits: int = 4) -> str:
@@ -137,13 +146,15 @@ def nbo_error_claim(nbo: pd.DataFrame, conv: pd.DataFrame) -> Claim:
     rule = nbo_error_rule(check.z_limit, check.n_tests)
     return Claim(
         id="LQG-1",
-        claim="NBO's error is J - J_NBO = r σ² Σ_{n<H} (1-a)^{2n} for every a and H",
+        claim="In the oven LQG, NBO's error is J - J_NBO = r σ² Σ_{n<H} (1-a)^{2n} for every a "
+        "and H run",
         paper="Sec. III-A: |J_NBO - J| = r σ² Σ_{n=0}^{H-1} (1-a)^{2n} (derived for H = 2, "
         "stated for any H)",
         key=KeyNumber(f"max |z| over {check.n_tests} tests", check.max_abs_z, digits=3),
         verdict=rule.verdict({"max |z|": check.max_abs_z}),
         rule=rule.text(),
         measured=_nbo_error_measured(check),
+        setup=SETUP,
     )
 
 
@@ -163,8 +174,13 @@ FIG3_RULE = Rule(
         ),
         Case(
             "not supported",
-            "the slope CI lies at/above 0 or the RMSE's lower limit reaches |J - J_NBO|",
-            lambda f: f["slope_low"] >= 0 or f["nbo_error"] <= f["rmse_low"],
+            "the slope CI lies at/above 0, or at the largest P the CI of the mean J_P excludes "
+            "J (a bias that does not vanish) or the RMSE's lower limit reaches |J - J_NBO|",
+            lambda f: (
+                f["slope_low"] >= 0
+                or not f["mean_low"] <= f["J"] <= f["mean_high"]
+                or f["nbo_error"] <= f["rmse_low"]
+            ),
         ),
     ),
     otherwise="inconclusive",
@@ -206,7 +222,8 @@ def fig3_claim(summary: pd.DataFrame) -> Claim:
     fit = check.fit
     return Claim(
         id="LQG-2",
-        claim="MHP's estimate J_P approaches J as P grows while NBO stays biased (Fig. 3)",
+        claim="In the oven LQG at the paper's setting, the Monte-Carlo estimate J_P approaches "
+        "J as P grows while NBO's stays biased (Fig. 3)",
         paper=f"{PAPER_FIG3}: MHP estimate close to J for P = 100..10000; NBO error high",
         key=KeyNumber(
             "slope of log RMSE vs log P",
@@ -219,60 +236,105 @@ def fig3_claim(summary: pd.DataFrame) -> Claim:
         verdict=FIG3_RULE.verdict(fig3_facts(check)),
         rule=FIG3_RULE.text(),
         measured=_fig3_measured(check),
+        setup=SETUP,
     )
 
 
 # ------------------------------------------------------------------------------- LQG-3
 
-CHEBYSHEV_RULE = Rule(
-    basis="count informative (P, ε) cells (Var(g)/(Pε²) < 1) whose Clopper-Pearson lower "
-    "limit of P(|J_P - J| ≥ ε), familywise 95% (Bonferroni over these cells), lies above the "
-    "bound",
-    cases=(
-        Case("inconclusive", "no cell is informative", lambda f: f["informative cells"] == 0),
-        Case("supported", "the count is 0", lambda f: f["count"] == 0),
-    ),
-    otherwise="not supported",
+
+def exceedance_rule(basis: str) -> Rule:
+    """The rule of Prop. 3's evidence (LQG-3, EST-3, LIN-1): exceedance counts against the
+    exact tail probability (power) and against Chebyshev's bound (the statement)."""
+    return Rule(
+        basis=basis,
+        cases=(
+            Case(
+                "not supported",
+                "some cell's exceedance frequency lies significantly above Chebyshev's bound "
+                "(familywise 95% Clopper-Pearson lower limit above it)",
+                lambda f: f["above bound"] >= 1,
+            ),
+            Case(
+                "supported",
+                "no cell's count departs from the exact probability (two-sided exact binomial "
+                "tests, familywise 95%) and the exact probability is below the bound in every "
+                "cell",
+                lambda f: f["cells"] >= 1 and f["departing"] == 0 and f["exact above bound"] == 0,
+            ),
+        ),
+        otherwise="inconclusive",
+    )
+
+
+def exceedance_facts(test: ExceedanceTest) -> Facts:
+    """The facts of :func:`exceedance_rule` from :func:`rsmhp.stats.exceedance_test`."""
+    return {
+        "cells": test.cells,
+        "departing": test.departing,
+        "above bound": test.above_bound,
+        "exact above bound": test.exact_above_bound,
+    }
+
+
+CHEBYSHEV_RULE = exceedance_rule(
+    "per (P, ε) cell, the count of |J_P − J| ≥ ε over the replicates against its exact "
+    "probability (J_P: mean of P copies of the quadratic trajectory cost, a generalised "
+    "chi-square) and against Chebyshev's bound Var(g)/(P ε²)"
 )
 
 
 def chebyshev_facts(check: ChebyshevCheck) -> Facts:
     """The numbers :data:`CHEBYSHEV_RULE` is evaluated on."""
-    return {"informative cells": check.n_informative, "count": check.n_significant}
+    return exceedance_facts(check.test)
 
 
 def _chebyshev_measured(check: ChebyshevCheck, eps_values: Sequence[float]) -> str:
-    if not check.n_informative:
-        return f"none of the {check.n_cells} (P, ε) cells has an informative bound"
     eps_text = ", ".join(eps_label(e) for e in eps_values)
+    t = check.test
+    power = (
+        f"the test detects a spread of J_P − J off by {fmt(100 * check.detectable, 2)}% "
+        "with 80% power in its most sensitive cell"
+        if np.isfinite(check.detectable)
+        else "no cell detects a spread error below 50% with 80% power"
+    )
     return (
-        f"{check.n_informative} informative of {check.n_cells} (P, ε) cells, ε ∈ {{{eps_text}}}, "
-        f"{check.replicates} replicates per P; {check.n_significant} cells "
-        f"significantly above the bound; observed frequency at most {fmt(check.max_ratio, 2)} "
-        f"× the bound (P = {check.worst_P}, ε = {eps_label(check.worst_eps)}); per-cell 95% "
-        f"Clopper-Pearson lower limits above the bound (no familywise correction): "
-        f"{check.n_significant_per_cell}"
+        f"{t.cells} (P, ε) cells, ε ∈ {{{eps_text}}}, {check.replicates} replicates per P; "
+        f"{t.departing} cells depart from the exact probability, {t.above_bound} lie "
+        f"significantly above the bound; smallest adjusted p = {fmt(t.min_p, 3)} at "
+        f"P = {check.worst_P}, ε = {eps_label(check.worst_eps)} (frequency "
+        f"{fmt(check.worst_freq, 3)} vs exact {fmt(check.worst_exact, 3)}); "
+        + (
+            f"exact probability at most {fmt(t.max_exact_ratio, 2)} × the bound in the "
+            f"{check.n_informative} cells where the bound is below 1 (the old Chebyshev-only "
+            f"test could fail only if the variance were about "
+            f"{fmt(1 / t.max_exact_ratio, 2)}× too small); "
+            if np.isfinite(t.max_exact_ratio)
+            else "no cell has a bound below 1; "
+        )
+        + power
     )
 
 
 def chebyshev_claim(summary: pd.DataFrame, eps_values: Sequence[float]) -> Claim:
-    """Claim LQG-3 (Prop. 3): no informative (P, ε) cell exceeds the Chebyshev bound
-    significantly (familywise Clopper-Pearson lower limit above the bound)."""
+    """Claim LQG-3 (Prop. 3 on the oven's quadratic cost): exceedances against the exact tail
+    probability and against Chebyshev's bound."""
     check = chebyshev_check(summary, eps_values)
     return Claim(
         id="LQG-3",
-        claim="Prop. 3: P(|J_P - J| ≥ ε) ≤ Var(g)/(P ε²) for independent trajectories",
-        paper="Sec. II-A, Prop. 3: P(|J_N - J| ≥ ε) ≤ Var(p)/(N ε²) (Chebyshev)",
-        key=KeyNumber("cells significantly above the bound", float(check.n_significant), digits=1),
+        claim="In the oven LQG at the paper's setting, the Monte-Carlo estimate's error obeys "
+        "P(|J_P - J| ≥ ε) ≤ Var(g)/(P ε²), and its exceedances match the exact probability",
+        paper="Sec. II-A, Prop. 3: P(|J_N - J| ≥ ε) ≤ Var(p)/(N ε²) (Chebyshev; stated for a "
+        "linear cost, the bound holds for any finite variance)",
+        key=KeyNumber(
+            f"smallest adjusted p, exceedances vs exact probability ({check.n_cells} cells)",
+            check.test.min_p,
+            digits=3,
+        ),
         verdict=CHEBYSHEV_RULE.verdict(chebyshev_facts(check)),
         rule=CHEBYSHEV_RULE.text(),
         measured=_chebyshev_measured(check, eps_values),
-        dropped=(
-            f"{check.n_vacuous} of {check.n_cells} cells where Var(g)/(Pε²) ≥ 1: the bound is "
-            "vacuous (no probability exceeds 1), so they cannot contradict it"
-            if check.n_vacuous
-            else ""
-        ),
+        setup=SETUP,
     )
 
 
@@ -312,7 +374,8 @@ def weighted_claim(summary: pd.DataFrame) -> Claim:
     d = ci_digits(check.ci_low, check.ci_high)
     return Claim(
         id="LQG-4",
-        claim="Prop. 2 (non-overlapping form): the likeliness-weighted average converges to J",
+        claim="In the oven LQG at the paper's setting, the likeliness-weighted average of "
+        "independent trajectories converges to J (Prop. 2, non-overlapping form)",
         paper="Sec. II and II-A, Prop. 2: weighted average J~_N → J in probability",
         key=KeyNumber(
             f"weighted estimate at P = {check.P} (J = {fmt_exact(check.J, 4)})",
@@ -329,6 +392,75 @@ def weighted_claim(summary: pd.DataFrame) -> Claim:
             f"{fmt_exact(check.J, d)} ({'inside' if check.contains_j else 'outside'}); "
             f"{check.replicates} replicates"
         ),
+        setup=SETUP,
+    )
+
+
+# ------------------------------------------------------------------------------- LIN-1
+
+LINEAR_RULE = Rule(
+    basis="Prop. 3's own setting (linear dynamics, linear cost): z of the sample variance of "
+    "J_n against the paper's formula C[Σ_k 𝒜_k Σ 𝒜_kᵀ]Cᵀ/n (chi-square, exact for Gaussian "
+    "J_n) per n and pooled, z of the mean against J per n; per (n, k) cell the count of "
+    "|J_n − J| ≥ k sd_n against its exact probability 2Φ(−k) and Chebyshev's 1/k²",
+    cases=(
+        Case(
+            "not supported",
+            "some |z| exceeds its Bonferroni limit (familywise 95%) or some cell's "
+            "exceedance frequency lies significantly above 1/k²",
+            lambda f: f["max |z|"] > f["z limit"] or f["above bound"] >= 1,
+        ),
+        Case(
+            "supported",
+            "every |z| is within the limit, no cell's count departs from the exact "
+            "probability and the exact probability is below 1/k² in every cell",
+            lambda f: f["cells"] >= 1 and f["departing"] == 0 and f["exact above bound"] == 0,
+        ),
+    ),
+    otherwise="inconclusive",
+)
+
+
+def linear_facts(check: LinearCostCheck) -> Facts:
+    """The numbers :data:`LINEAR_RULE` is evaluated on."""
+    return {
+        "max |z|": check.max_abs_z,
+        "z limit": check.z_limit,
+        **exceedance_facts(check.exceedance),
+    }
+
+
+def linear_claim(check: LinearCostCheck) -> Claim:
+    """Claim LIN-1: Prop. 3's variance formula and bound on a linear-cost system."""
+    zs = ", ".join(
+        f"n = {n}: {fmt(v, 2, True)} / {fmt(m, 2, True)}"
+        for n, v, m in zip(check.n, check.var_z, check.mean_z, strict=True)
+    )
+    t = check.exceedance
+    return Claim(
+        id="LIN-1",
+        claim="On a linear-cost system (Prop. 3's premise), the Monte-Carlo estimate's "
+        "variance is C[Σ_k 𝒜_k Σ 𝒜_kᵀ]Cᵀ/N and its error obeys Chebyshev's bound, with "
+        "exceedances matching the exact probability",
+        paper="Sec. II-A, Prop. 3: Var(p) = C[Σ_k 𝒜_k Σ 𝒜_kᵀ]Cᵀ and "
+        "P(|J_N - J| ≥ ε) ≤ Var(p)/(N ε²) for linear dynamics and a linear cost",
+        key=KeyNumber(
+            f"max |z| over {2 * len(check.n) + 1} variance and mean tests", check.max_abs_z
+        ),
+        verdict=LINEAR_RULE.verdict(linear_facts(check)),
+        rule=LINEAR_RULE.text(),
+        measured=f"H = {check.H}, {check.replicates} replicates per n; Var(p) = "
+        f"{fmt(check.var_prop3, 6)} by the paper's formula and {fmt(check.var_form, 6)} from "
+        f"the cost's quadratic form; z of the variance / of the mean: {zs}; pooled variance "
+        f"z = {fmt(check.pooled_z, 2, True)} (Bonferroni limit {fmt(check.z_limit, 3)}); "
+        f"{t.cells} (n, k) cells: {t.departing} depart from 2Φ(−k), {t.above_bound} lie "
+        f"significantly above 1/k²"
+        + (
+            f"; 2Φ(−k) is at most {fmt(t.max_exact_ratio, 2)} × 1/k²"
+            if np.isfinite(t.max_exact_ratio)
+            else ""
+        ),
+        setup=f"linear-cost 2-D system (LinearCost.example, H = {check.H})",
     )
 
 
@@ -338,8 +470,16 @@ def convergence_claims(summary: pd.DataFrame, eps_values: Sequence[float]) -> li
 
 
 def lqg_claims(
-    summary: pd.DataFrame, nbo: pd.DataFrame, conv: pd.DataFrame, eps_values: Sequence[float]
+    summary: pd.DataFrame,
+    nbo: pd.DataFrame,
+    conv: pd.DataFrame,
+    eps_values: Sequence[float],
+    linear: LinearCostCheck,
 ) -> list[Claim]:
-    """Claims LQG-1..LQG-4 from the per-P summary, the NBO-error summary and the convergence
-    table (:mod:`rsmhp.analysis.lqg`)."""
-    return [nbo_error_claim(nbo, conv), *convergence_claims(summary, eps_values)]
+    """Claims LQG-1..LQG-4 and LIN-1 from the per-P summary, the NBO-error summary, the
+    convergence table and the linear-cost check (:mod:`rsmhp.analysis.lqg`)."""
+    return [
+        nbo_error_claim(nbo, conv),
+        *convergence_claims(summary, eps_values),
+        linear_claim(linear),
+    ]

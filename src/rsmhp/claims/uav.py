@@ -3,10 +3,13 @@ mean difference is the key number, judged by one verdict rule (:func:`paired_rul
 :func:`rsmhp.verdicts.ci_side` rule: its printed text and its evaluation are one object).
 
 For a claim "A has lower error than B" with :math:`d_r = e_r(A) - e_r(B)` and the 95%
-bootstrap CI :math:`[l, h]` of :math:`\bar d`: *supported* if :math:`h < 0` (the CI lies
-entirely below 0), *not supported* if :math:`l > 0` (entirely above 0), *inconclusive*
-otherwise, i.e. when the CI contains or touches 0 (no detectable difference at this number of
-runs; the CI says how large a difference is still compatible with the data).
+bootstrap CI :math:`[l, h]` of :math:`\bar d`: *equivalent* if :math:`-m < l` and
+:math:`h < m` (whatever the difference is, it is smaller than the margin m fixed in the config
+before the run, ``uav.analysis.equivalence_margin``), else *supported* if :math:`h < 0` (the
+CI lies entirely below 0), *not supported* if :math:`l > 0` (entirely above 0),
+*inconclusive* otherwise (a difference of m or more is still compatible with the data).
+Comparisons of the same kind whose CI lies on the opposite side are named as contrary
+evidence; for UAV-3 also the planning time, where the pruned tree was the slower.
 
 The claims are the paper's, about specific families (referenced through their classes):
 
@@ -26,7 +29,7 @@ import pandas as pd
 
 from rsmhp.analysis.uav import PRUNING, TREND, baseline_name, family_rows, vs_baseline
 from rsmhp.ledger import Claim, KeyNumber
-from rsmhp.markdown import fmt, fmt_ci
+from rsmhp.markdown import fmt, fmt_ci, param_text
 from rsmhp.palette import method_label
 from rsmhp.uav.methods.monte_carlo import MonteCarlo
 from rsmhp.verdicts import Facts, Rule, ci_side
@@ -36,15 +39,21 @@ __all__ = ["KEY", "key_comparisons", "paired_facts", "paired_rule", "short_name"
 #: the key number of every UAV claim, as the rule names it (facts ``mean d_low/high``)
 KEY = "mean d"
 
+#: the setup every UAV claim is tested on
+SETUP = "UAV reconstruction (Sec. III-B), closed loop"
 
-def paired_rule(a: str, b: str) -> Rule:
-    """The rule of "``a`` has lower error than ``b``" (short method names, printed)."""
+
+def paired_rule(a: str, b: str, margin: float) -> Rule:
+    """The rule of "``a`` has lower error than ``b``" (short method names, printed), with the
+    equivalence margin ±``margin`` (m), fixed in the config before the run."""
     return ci_side(
         KEY,
         0.0,
         claimed="below",
         basis=f"d_r = e_r({a}) − e_r({b}), e_r = run r's average target location error (m); "
         "95% percentile bootstrap CI over runs",
+        margin=margin,
+        margin_text=f"{param_text(margin)} m",
     )
 
 
@@ -102,7 +111,14 @@ def _dropped(row: pd.Series) -> str:
 
 
 def _claim(
-    cid: str, claim: str, paper: str, row: pd.Series, measured: str, dropped: str = ""
+    cid: str,
+    claim: str,
+    paper: str,
+    row: pd.Series,
+    measured: str,
+    margin: float,
+    dropped: str = "",
+    contrary: str = "",
 ) -> Claim:
     """Claim ``cid`` whose key number is the mean difference of the paired ``row``."""
     a, b = short_name(row["method"]), short_name(row["baseline"])
@@ -116,7 +132,7 @@ def _claim(
         digits=2,
         null=0.0,
     )
-    rule = paired_rule(a, b)
+    rule = paired_rule(a, b, margin)
     return Claim(
         id=cid,
         claim=claim,
@@ -126,6 +142,9 @@ def _claim(
         rule=rule.text(),
         measured=measured,
         dropped="; ".join(x for x in (dropped, _dropped(row)) if x),
+        part="paper",
+        setup=SETUP,
+        contrary=contrary,
     )
 
 
@@ -135,7 +154,12 @@ def _pick(paired: pd.DataFrame, ab: tuple[str, str]) -> tuple[pd.Series, pd.Seri
     return paired[is_key].iloc[0], is_key
 
 
-def _uav1(summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str]) -> Claim:
+def _opposite(rows: pd.DataFrame) -> str:
+    """The comparisons among ``rows`` whose CI lies above 0 (A significantly worse than B)."""
+    return _alongside(rows[rows["ci_low"] > 0])
+
+
+def _uav1(summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str], margin: float) -> Claim:
     main, is_key = _pick(paired, ab)
     rs = family_rows(summary, MonteCarlo)
     trend = (paired["purpose"] == TREND) & ~is_key
@@ -146,15 +170,18 @@ def _uav1(summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str]) -> C
     nts = ", ".join(str(int(n)) for n in rs["N_T"])
     return _claim(
         "UAV-1",
-        f"Average target location error falls as N_T grows (N_T = {nts})",
+        f"On the UAV reconstruction (closed loop), the average target location error falls "
+        f"as N_T grows (N_T = {nts})",
         "Sec. III-B, Fig. 4: CDFs of the average location error improve gradually with "
         "N_T = 50, 100, 250 (H = 6)",
         main,
         measured,
+        margin,
+        contrary=_opposite(paired[trend]),
     )
 
 
-def _uav2(paired: pd.DataFrame, ab: tuple[str, str]) -> Claim:
+def _uav2(paired: pd.DataFrame, ab: tuple[str, str], margin: float) -> Claim:
     main, is_key = _pick(paired, ab)
     others = (paired["purpose"] == vs_baseline()) & ~is_key
     measured = _stats(main)
@@ -162,41 +189,70 @@ def _uav2(paired: pd.DataFrame, ab: tuple[str, str]) -> Claim:
         measured += f"; other methods − NBO (mean d, CI): {_alongside(paired[others])}"
     return _claim(
         "UAV-2",
-        f"RS-MHP ({short_name(main['method'])}) gives lower target location error than NBO",
+        f"On the UAV reconstruction (closed loop), RS-MHP ({short_name(main['method'])}) "
+        "gives a lower average target location error than NBO",
         "Sec. III-B, Fig. 5: CDF of the average location error, RS-MHP better than NBO",
         main,
         measured,
+        margin,
+        contrary=_opposite(paired[others]),
     )
 
 
-def _uav3(paired: pd.DataFrame, ab: tuple[str, str]) -> Claim:
+def _seconds(summary: pd.DataFrame, method: str) -> float:
+    row = summary[summary["method"] == method]
+    return float(row["plan_seconds_per_run"].iloc[0]) if len(row) else float("nan")
+
+
+def _compute(summary: pd.DataFrame, pruned: str, flat: str) -> tuple[str, bool]:
+    """Planning seconds per closed-loop run of the pruned tree and of N_T = M (machine
+    dependent), and whether the pruned tree was the slower."""
+    sp, sf = _seconds(summary, pruned), _seconds(summary, flat)
+    if not (np.isfinite(sp) and np.isfinite(sf)):
+        return "", False
+    text = (
+        f"compute: {method_label(pruned)} planned in {fmt(sp, 3)} s per closed-loop run, "
+        f"{method_label(flat)} in {fmt(sf, 3)} s ({fmt(sp / sf, 3)}×; timings of this machine)"
+    )
+    return text, sp > sf
+
+
+def _uav3(summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str], margin: float) -> Claim:
     main, is_key = _pick(paired, ab)
     others = paired[(paired["purpose"] == PRUNING) & ~is_key]
+    compute, slower = _compute(summary, main["baseline"], main["method"])
+    contrary = [_opposite(paired[(paired["purpose"] == PRUNING)])]
+    if slower:
+        contrary.append(f"{compute}: the pruned tree did not save computation here")
+    measured = _stats(main) + (f"; {compute}" if compute and not slower else "")
     return _claim(
         "UAV-3",
-        "Pruning degrades RS-MHP: non-overlapping N_T = M beats the pruned tree keeping "
-        "M trajectories",
+        "On the UAV reconstruction (closed loop), pruning degrades RS-MHP: independent "
+        "trajectories N_T = M give a lower error than the pruned tree keeping M trajectories",
         "Sec. III-B, text after Fig. 4: the N_T trend suggests pruning would degrade "
-        "RS-MHP (no experiment shown)",
+        "RS-MHP but save computation (no experiment shown)",
         main,
-        _stats(main),
+        measured,
+        margin,
         dropped=(
             "further pruned trees, reported but not the key number (the first one is): "
             + _alongside(others)
             if len(others)
             else ""
         ),
+        contrary="; ".join(c for c in contrary if c),
     )
 
 
-def uav_claims(summary: pd.DataFrame, paired: pd.DataFrame) -> list[Claim]:
-    """Claims UAV-1..3 by :func:`paired_rule` (those whose methods were run)."""
+def uav_claims(summary: pd.DataFrame, paired: pd.DataFrame, margin: float) -> list[Claim]:
+    """Claims UAV-1..3 by :func:`paired_rule` (those whose methods were run); ``margin`` is
+    the equivalence margin (m, ``uav.analysis.equivalence_margin``)."""
     keys = key_comparisons(summary, paired)
     claims = []
     if "UAV-1" in keys:
-        claims.append(_uav1(summary, paired, keys["UAV-1"]))
+        claims.append(_uav1(summary, paired, keys["UAV-1"], margin))
     if "UAV-2" in keys:
-        claims.append(_uav2(paired, keys["UAV-2"]))
+        claims.append(_uav2(paired, keys["UAV-2"], margin))
     if "UAV-3" in keys:
-        claims.append(_uav3(paired, keys["UAV-3"]))
+        claims.append(_uav3(summary, paired, keys["UAV-3"], margin))
     return claims

@@ -1,4 +1,5 @@
-"""LQG experiments: estimator convergence in P (paper Fig. 3) and the NBO error over (a, H).
+"""LQG experiments: estimator convergence in P (paper Fig. 3), the NBO error over (a, H), and
+Prop. 3 on its own setting (linear dynamics, linear cost: :func:`run_linear_cost`).
 
 Both drivers return one row per (parameters, replicate). Row ``(P, replicate)`` draws
 its ``P x H`` noise from ``job_rng(seed, <experiment>, a=..., H=..., ..., P=P, replicate=i)``.
@@ -17,18 +18,22 @@ import pandas as pd
 from rsmhp import lqg
 from rsmhp.contracts import Contract
 from rsmhp.cost_estimators import nbo_estimate, uniform_estimate, weighted_estimate
+from rsmhp.linear_quadratic import LinearCost
 from rsmhp.parallel import chunked, parallel_map
 from rsmhp.sampling import sample_independent
 from rsmhp.seeding import job_rng
 
 __all__ = [
     "CONVERGENCE_COLUMNS",
+    "LINEAR_COST_COLUMNS",
     "NBO_ERROR_COLUMNS",
     "convergence_contract",
     "estimate_row",
+    "linear_cost_contract",
     "nbo_error_contract",
     "p_grid",
     "run_convergence",
+    "run_linear_cost",
     "run_nbo_error",
 ]
 
@@ -264,3 +269,43 @@ def run_nbo_error(cfg: Mapping[str, Any], seed: int, n_jobs: int = 1) -> pd.Data
     ]
     df = pd.DataFrame(rows, columns=NBO_ERROR_COLUMNS)
     return df.sort_values(["a", "H", "replicate"], kind="stable").reset_index(drop=True)
+
+
+LINEAR_COST_COLUMNS = ["H", "n", "replicate", "estimate", "J_exact", "var_prop3"]
+
+
+def linear_cost_contract(cfg: Mapping[str, Any]) -> Contract:
+    """What ``results/lqg/linear_cost.csv`` must hold for the ``lqg`` config section ``cfg``:
+    one row per (n, replicate) of ``lqg.linear_cost``."""
+    lc = cfg["linear_cost"]
+    keys = itertools.product([int(n) for n in lc["n"]], range(int(lc["replicates"])))
+    return Contract(
+        rule="lqg_linear_cost",
+        columns=LINEAR_COST_COLUMNS,
+        integer=("H", "n", "replicate"),
+        keys=("n", "replicate"),
+        expected=pd.DataFrame(list(keys), columns=["n", "replicate"]),
+        values={"H": int(lc["H"])},
+    )
+
+
+def run_linear_cost(cfg: Mapping[str, Any], seed: int) -> pd.DataFrame:
+    r"""Prop. 3 on its own premise: the linear-cost system :meth:`LinearCost.example` (H from
+    ``cfg["linear_cost"]``), for each n of the grid ``replicates`` Monte-Carlo estimates
+    :math:`J_n = \frac1n\sum_i p_i` of n independent trajectories
+    (:func:`rsmhp.sampling.sample_independent`; replicate ``i`` of size ``n`` draws from
+    ``job_rng(seed, "lqg_linear_cost", H=H, n=n, replicate=i)``), next to the exact
+    :math:`J = E[p]` and the paper's variance formula :math:`\mathrm{Var}(p) =
+    C[\sum_k \mathcal A_k \Sigma \mathcal A_k^\top]C^\top` (``var_prop3``)."""
+    lc = cfg["linear_cost"]
+    H, reps = int(lc["H"]), int(lc["replicates"])
+    system = LinearCost.example(H)
+    j_exact, var = system.exact_cost(), system.prop3_variance()
+    log.info("lqg_linear_cost: H = %d, n in %s, %d replicates", H, list(lc["n"]), reps)
+    rows = []
+    for n in (int(v) for v in lc["n"]):
+        for rep in range(reps):
+            rng = job_rng(seed, "lqg_linear_cost", H=H, n=n, replicate=rep)
+            cost = sample_independent(system, system.x0, system.u, n, rng).cost
+            rows.append((H, n, rep, float(cost.mean()), j_exact, var))
+    return pd.DataFrame(rows, columns=LINEAR_COST_COLUMNS)

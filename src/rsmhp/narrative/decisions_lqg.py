@@ -150,7 +150,7 @@ CLOSED_FORM_PARAGRAPH = (
     "and v_H the mean and variance of the final state, and v_H does not depend on u, "
     "so NBO (noise at its mean) has J's minimiser. A sample average shifts the target "
     "by the mean ē of the sampled final-state noises, giving regret κ ē², "
-    "κ = r²a²|c|²/(1 + r a²|c|²), c_k = (1 − a)^{H−1−k}: mean κ v_H / P for "
+    "κ = r²a²‖β‖²/(1 + r a²‖β‖²), β_k = (1 − a)^{H−1−k}: mean κ v_H / P for "
     "independent trajectories, κ v_H / N (not / N^H) for the shared-draw tree, 0 for "
     "antithetic pairs and symmetric cubature points. z = (simulated − closed-form "
     "mean) / its standard error."

@@ -260,11 +260,13 @@ def uav_decision_section(
     tables: Mapping[str, str],
     cfg: Mapping[str, Any],
     seed: int,
+    base_limited: bool = False,
 ) -> Section:
     """The decision study's UAV report section (order 31); ``cfg`` is the ``decisions``
-    config section, ``groups`` :func:`rsmhp.analysis.decisions_uav.summarize_map_groups`."""
+    config section, ``groups`` :func:`rsmhp.analysis.decisions_uav.summarize_map_groups`,
+    ``base_limited`` whether the base config's sensor has a footprint."""
     n_boot = int(cfg["map"]["bootstrap"])
-    claims = uav_claims(regret, summary, map_df, groups, seed, n_boot)
+    claims = uav_claims(regret, summary, map_df, groups, cfg["claims"], seed, n_boot, base_limited)
     base = base_model(list(dict.fromkeys(regret["model"])))
     findings = _findings(claims, regret, summary, base)
     body = "\n".join([*_setting(cfg), "", findings, "", *_FIGURE_TEXT])

@@ -5,7 +5,7 @@ Markdown tables, from the statistics of :mod:`rsmhp.analysis.estimators` and the
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Iterable, Mapping
 from typing import Any
 
 import numpy as np
@@ -15,7 +15,6 @@ from rsmhp.analysis.estimators import (
     MIN_TREE_SIZES,
     antithetic_ratios,
     best_stochastic_gains,
-    chebyshev_table,
     equal_cpu_gains,
     exact_rule_error,
     largest_cells,
@@ -123,9 +122,8 @@ def gain_table(s: pd.DataFrame) -> str:
     return markdown_table(out, digits=3)
 
 
-def _chebyshev_table(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> str:
-    """The Chebyshev exceedances at the largest n."""
-    cheb = chebyshev_table(df, s, ks)
+def _chebyshev_table(cheb: pd.DataFrame) -> str:
+    """The Chebyshev exceedances at the largest n, with the exact probability."""
     if not len(cheb):
         return markdown_table(pd.DataFrame({"problem": []}), digits=3)
     cheb = cheb[cheb["n"] == cheb["n"].max()]
@@ -135,6 +133,7 @@ def _chebyshev_table(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> 
             "n": cheb["n"],
             "k": [k_text(k) for k in cheb["k"]],
             "bound 1/k²": cheb["bound"],
+            "exact": cheb["exact"],
             "observed": cheb["freq"],
             "95% CI": _ci_column(cheb["low"], cheb["high"]),
         }
@@ -160,7 +159,7 @@ def _weighted_table(s: pd.DataFrame) -> str:
     return markdown_table(pd.DataFrame(rows), digits=4)
 
 
-def tables(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> dict[str, str]:
+def tables(df: pd.DataFrame, s: pd.DataFrame, cheb: pd.DataFrame) -> dict[str, str]:
     """Markdown tables keyed by file stem (``results/tables/<stem>.md``)."""
     tvi = tree_vs_independent(s).rename(
         columns={
@@ -176,7 +175,7 @@ def tables(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> dict[str, 
         "est_pruning": markdown_table(pruning_pivot(s), digits=3, missing=ABSENT),
         "est_weighted": _weighted_table(s),
         "est_equal_cpu": gain_table(s),
-        "est_chebyshev": _chebyshev_table(df, s, ks),
+        "est_chebyshev": _chebyshev_table(cheb),
     }
 
 
@@ -224,21 +223,22 @@ def _weighting_finding(s: pd.DataFrame) -> list[str]:
     return [txt + "."]
 
 
-def _other_findings(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> list[str]:
+def _other_findings(s: pd.DataFrame, cheb: pd.DataFrame) -> list[str]:
     out = []
     top = pruning_at_largest_n(s)
     if len(top):
         out.append(
             "Pruning with M fixed keeps draws ever nearer the mode as N grows, so the estimate "
-            f"tends to c: at N = {int(top['N'].max())} its bias is "
+            f"tends to the NBO cost J_NBO: at N = {int(top['N'].max())} its bias is "
             f"{range_text(top['bias_fraction_of_nbo'] * 100, 2, '%')} of J_NBO - J."
         )
-    cheb = chebyshev_table(df, s, ks)
     if len(cheb):
         rate = [f.slope for f in mc_variance_slopes(s).values()]
         out.append(
             "Plain MC's exceedance frequency is below Chebyshev's bound (upper CI limit) in "
-            f"{int((cheb['high'] < cheb['bound']).sum())}/{len(cheb)} (problem, n, k) cells"
+            f"{int((cheb['high'] < cheb['bound']).sum())}/{len(cheb)} (problem, n, k) cells, "
+            "and the exact probability (a generalised chi-square) lies at "
+            f"{range_text(cheb['exact'] / cheb['bound'], 2)} × the bound"
             + (f"; its variance slope vs n is {range_text(rate, 3)}." if rate else ".")
         )
     big = sobol_rmse_ratios(s)
@@ -251,9 +251,9 @@ def _other_findings(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> l
     return out
 
 
-def _findings(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> list[str]:
+def _findings(s: pd.DataFrame, cheb: pd.DataFrame) -> list[str]:
     """Sentences of the body's findings paragraph, each built only if its data exist."""
-    return [*_tree_findings(s), *_weighting_finding(s), *_other_findings(df, s, ks)]
+    return [*_tree_findings(s), *_weighting_finding(s), *_other_findings(s, cheb)]
 
 
 _SYMBOLS = (
@@ -299,11 +299,11 @@ def _run_text(s: pd.DataFrame) -> str:
     )
 
 
-def _body(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> str:
+def _body(s: pd.DataFrame, cheb: pd.DataFrame) -> str:
     parts = [
         _run_text(s),
         _SYMBOLS,
-        "**Found.** " + " ".join(_findings(df, s, ks)),
+        "**Found.** " + " ".join(_findings(s, cheb)),
         "Figures: weighted variants dotted, derived values dashed; y ranges follow the point "
         "estimates, CI bars beyond are cut (count in the panel title).",
     ]
@@ -313,7 +313,7 @@ def _body(df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float]) -> str:
 
 
 def estimators_section(
-    df: pd.DataFrame, s: pd.DataFrame, ks: Sequence[float], tabs: Mapping[str, str]
+    df: pd.DataFrame, s: pd.DataFrame, cheb: pd.DataFrame, tabs: Mapping[str, str]
 ) -> Section:
     """The estimator-study report section (order 15): a short body (what was run, symbols,
     findings, figures), the claims EST-1..EST-4 and an appendix (rules, samplers beyond the
@@ -322,8 +322,8 @@ def estimators_section(
         key="estimators",
         title="Estimator study: tree vs independent sampling, pruning, weighting, samplers",
         order=15,
-        body=_body(df, s, ks),
-        claims=claims(df, s, ks),
+        body=_body(s, cheb),
+        claims=claims(s, cheb),
         figures=[f"{f}.png" for f in FIGURES],
         appendix=_appendix(s, tabs),
     )

@@ -13,8 +13,8 @@ import pandas as pd
 
 from rsmhp.analysis.uav import family_rows, figure_notes, is_family
 from rsmhp.claims.uav import uav_claims
-from rsmhp.ledger import Claim, Section
-from rsmhp.markdown import fmt, fmt_ci, markdown_table
+from rsmhp.ledger import VERDICTS, Claim, Section
+from rsmhp.markdown import fmt, fmt_ci, markdown_table, param_text
 from rsmhp.palette import method_label
 from rsmhp.uav import methods as registry
 from rsmhp.uav.methods.monte_carlo import MonteCarlo
@@ -117,30 +117,46 @@ def _methods_run(summary: pd.DataFrame) -> list[str]:
     return out + [method_label(m) for m in summary.loc[other, "method"]]
 
 
-def _findings(claims: Sequence[Claim], summary: pd.DataFrame) -> str:
-    """The body's findings: spread of the method means, key numbers, why they are what they
-    are (every number from the summary and the claims)."""
+def _findings(claims: Sequence[Claim], summary: pd.DataFrame, margin: float) -> str:
+    """The body's findings: spread of the method means, key numbers, the equivalence margin
+    and its justification, why the numbers are what they are (every number from the summary
+    and the claims)."""
     n_runs = int(summary["n_runs"].max())
-    n_incl = sum(c.verdict == "inconclusive" for c in claims)
+    counts = {v: sum(c.verdict == v for c in claims) for v in ("equivalent", "inconclusive")}
     verdicts = "; ".join(
         f"{c.id} {fmt(c.key.value, 2, True)} {fmt_ci(c.key.ci_low, c.key.ci_high, 2, True)} m "
         f"({c.verdict})"
         for c in claims
     )
+    mean_e, sd_e = float(summary["mean"].mean()), float(summary["sd"].median())
     spread = (
         f"Mean e of every method lies in [{fmt(summary['mean'].min(), 4)}, "
         f"{fmt(summary['mean'].max(), 4)}] m, while e varies between runs with SD "
-        f"{fmt(summary['sd'].median(), 2)} m. "
+        f"{fmt(sd_e, 2)} m. "
     )
     half = float(np.median([(c.key.ci_high - c.key.ci_low) / 2 for c in claims] or [0.0]))
-    pct = 100 * half / float(summary["mean"].mean())
+    pct = 100 * half / mean_e
+    margin_text = (
+        f"The equivalence margin m = {param_text(margin)} m (fixed in the config before the "
+        f"run) is {fmt(100 * margin / mean_e, 2)}% of the mean error and "
+        f"{fmt(margin / sd_e, 2)} of its run-to-run SD: a difference smaller than m would not "
+        "separate the CDFs of Figs. 4/5 visibly. "
+    )
+    decided = [f"{c.id} ({c.verdict})" for c in claims if c.verdict in VERDICTS[:2]]
     why = (
-        f"Every CI contains 0: any effect of the method on e is below what {n_runs} paired "
-        f"runs resolve (CI half-width about {fmt(half, 2)} m, {fmt(pct, 2)}% of mean e). "
-        if claims and n_incl == len(claims)
-        else f"{n_incl} of {len(claims)} CIs contain or touch 0. "
-    ) + "The decision study compares the plans themselves (DEC-6, DEC-8)."
-    return f"**Found.** {spread}Key numbers d̄ (CI): {verdicts}. {why}"
+        f"{counts['equivalent']} of {len(claims)} CIs lie inside ±m and "
+        f"{counts['inconclusive']} contain 0 without fitting inside it ({n_runs} paired runs, "
+        f"CI half-width about {fmt(half, 2)} m, {fmt(pct, 2)}% of mean e)"
+        + (
+            f"; CIs on one side of 0: {', '.join(decided)}. "
+            if decided
+            else ": on this reconstruction the differences the paper's figures show do not appear. "
+        )
+    )
+    return (
+        f"**Found.** {spread}Key numbers d̄ (CI): {verdicts}. {margin_text}{why}"
+        "The decision study compares the plans themselves (DEC-6, DEC-8)."
+    )
 
 
 def _figures(summary: pd.DataFrame, notes: Mapping[str, tuple[float, float, str]]) -> list[str]:
@@ -185,6 +201,7 @@ def _figures(summary: pd.DataFrame, notes: Mapping[str, tuple[float, float, str]
 
 
 def _body(
+    margin: float,
     claims: Sequence[Claim],
     summary: pd.DataFrame,
     setting: Mapping[str, Any],
@@ -210,7 +227,7 @@ def _body(
         f"of d̄ ({n_boot} resamples of runs); p: Wilcoxon signed-rank p-value of d."
     )
     return "\n".join(
-        [run, "", symbols, "", _findings(claims, summary), "", *_figures(summary, notes)]
+        [run, "", symbols, "", _findings(claims, summary, margin), "", *_figures(summary, notes)]
     )
 
 
@@ -264,16 +281,18 @@ def uav_section(
     setting: Mapping[str, Any],
     n_boot: int,
     runs: pd.DataFrame,
+    margin: float,
 ) -> Section:
     """The UAV report section (order 20): a short body (what was run, symbols, findings, the
-    paper-style CDFs each followed by its paired view) and an appendix (model, tables)."""
-    claims = uav_claims(summary, paired)
+    paper-style CDFs each followed by its paired view) and an appendix (model, tables);
+    ``margin`` is the claims' equivalence margin (m)."""
+    claims = uav_claims(summary, paired, margin)
     notes = figure_notes(runs, summary, paired)
     return Section(
         key="uav",
         title="Case study 2: UAV target tracking (paper Sec. III-B, Figs. 4-5)",
         order=20,
-        body=_body(claims, summary, setting, n_boot, notes),
+        body=_body(margin, claims, summary, setting, n_boot, notes),
         claims=claims,
         figures=[f"{f}.png" for f in FIGURES],
         appendix=_appendix(setting, tables),
