@@ -9,12 +9,14 @@ CORES ?= 2
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.rsmhp-installed
 
-.PHONY: help replicate publish verify test lint setup clean
+.PHONY: help replicate publish verify portability test lint setup clean
 
 help:
 	@echo "rsmhp: replication pipeline (RS-MHP vs NBO). Targets:"
 	@echo "  make replicate [ARGS=...]  set up .venv if needed, run the full replication (snakemake -j$(CORES) ARGS)"
 	@echo "  make verify [ARGS=...]     run what is missing, compare every claim with paper/claims.json"
+	@echo "  make portability [ARGS=...] rerun as on another CPU (numba generic, OpenBLAS Nehalem, no"
+	@echo "                             numpy SIMD) elsewhere; compare with results/ and paper/claims.json"
 	@echo "  make publish               update the tracked paper/ and README results from results/paper/"
 	@echo "  make test                  set up, lint, run the test suite (what CI runs)"
 	@echo "  make setup                 create .venv, install rsmhp[dev], compile the planner kernels"
@@ -54,6 +56,13 @@ publish: $(STAMP)
 # missing first); fails if a verdict flips or a key number leaves its tolerance
 verify: $(STAMP)
 	$(BIN)/snakemake -j$(CORES) verify $(ARGS)
+
+# portability drill: run what is missing natively, rerun the workflow emulating another CPU in a
+# temporary directory (results/ is only read), compare table by table and claim by claim;
+# writes results/portability/drill.md and drill.json; fails if a verdict differs or verify
+# fails. ARGS go to the drill: make portability ARGS="--openblas-coretype Haswell --keep"
+portability: $(STAMP)
+	$(BIN)/python -m rsmhp.portability --cores $(CORES) $(ARGS)
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

@@ -17,6 +17,7 @@ from matplotlib.colors import to_hex
 
 from rsmhp.analysis import decisions_uav as dec
 from rsmhp.claims import decisions_uav as dec_claims
+from rsmhp.config import check_config
 from rsmhp.experiments.decisions_uav import (
     MAP_RUN_COLUMNS,
     REGRET_COLUMNS,
@@ -27,6 +28,7 @@ from rsmhp.experiments.decisions_uav import (
     score_state,
 )
 from rsmhp.figures import decisions as figs
+from rsmhp.ledger import KeyNumber
 from rsmhp.narrative import decisions_uav as dec_text
 from rsmhp.palette import method_colour
 from rsmhp.uav import methods as uav_methods
@@ -160,10 +162,18 @@ EMPTY_REGRET = pd.DataFrame(columns=REGRET_COLUMNS).astype({"model": str})
 EMPTY_SUMMARY = pd.DataFrame(columns=dec.UAV_SUMMARY_COLUMNS).astype({"method": str})
 
 
-def _map_claims(runs: pd.DataFrame) -> dict:
-    m = dec.summarize_map(runs, pd.DataFrame(columns=REGRET_COLUMNS), MAP_CFG, 1, 500)
-    groups = dec.summarize_map_groups(runs, m, 1, 500)
-    claims = dec_claims.uav_claims(EMPTY_REGRET, EMPTY_SUMMARY, m, groups, 1, 500)
+#: the ``decisions.claims`` config of the tests (the schema's defaults)
+CLAIM_RULES = {"equivalence_margin_pp": 0.1, "map_method": ""}
+
+
+def _map_claims(
+    runs: pd.DataFrame, rules=CLAIM_RULES, cfg=MAP_CFG, base_limited: bool = False
+) -> tuple:
+    m = dec.summarize_map(runs, pd.DataFrame(columns=REGRET_COLUMNS), cfg, 1, 500)
+    groups = dec.summarize_map_groups(runs, m, 1, 500, base_limited)
+    claims = dec_claims.uav_claims(
+        EMPTY_REGRET, EMPTY_SUMMARY, m, groups, rules, 1, 500, base_limited
+    )
     return m, groups, {c.id: c for c in claims}
 
 
@@ -184,6 +194,12 @@ def test_map_claim_rule(shift, verdict):
         assert (key.value, key.ci_low, key.ci_high) == (g["mean_diff"], g["ci_low"], g["ci_high"])
         assert key.ci_low <= key.value <= key.ci_high
         assert not claims[cid].dropped  # one comparison only: nothing left out
+        assert claims[cid].part == "beyond" and "UAV sensitivity map" in claims[cid].setup
+        # the cells whose CI lies above 0 (RS-MHP worse) are named as contrary, and only then
+        cell = "footprint radius (m) 150" if limited else "footprint radius (m) unlimited"
+        assert (cell in claims[cid].contrary) == (verdict == "not supported")
+    assert "cells with a footprint" in claims["DEC-8a"].setup
+    assert "cells without a footprint" in claims["DEC-8b"].setup
 
 
 def test_map_group_needs_every_cell():
@@ -206,8 +222,103 @@ def test_map_group_drops_other_comparisons_by_name():
     extra = runs[runs["method"] == "rsmhp_nt100"].assign(method="rsmhp_nt250")
     _, groups, claims = _map_claims(pd.concat([runs, extra]))
     assert set(groups["comparison"]) == {"rsmhp_nt100 − nbo", "rsmhp_nt250 − nbo"}
-    assert "rsmhp_nt250" in claims["DEC-8a"].dropped  # the first N_T is the evidence
+    assert "N_T=250" in claims["DEC-8a"].dropped  # the first N_T is the evidence
     assert "N_T=100" in claims["DEC-8a"].claim
+
+
+def _two_members() -> pd.DataFrame:
+    """NBO, RS-MHP N_T=100 (2 m better than NBO) and N_T=250 (1 m worse) in both cells."""
+    runs = _map_runs(-2.0)
+    worse = runs[runs["method"] == "rsmhp_nt100"].assign(
+        method="rsmhp_nt250", mean_error=lambda d: d["mean_error"] + 3.0
+    )
+    return pd.concat([runs, worse])
+
+
+@pytest.mark.parametrize(
+    "method, compared, verdict",
+    [
+        ("", "rsmhp_nt100", "supported"),  # empty: the first RS-MHP member of the map
+        ("rsmhp_nt100", "rsmhp_nt100", "supported"),
+        ("rsmhp_nt250", "rsmhp_nt250", "not supported"),
+    ],
+)
+def test_dec8_compares_the_configured_map_method(method, compared, verdict):
+    m, groups, claims = _map_claims(_two_members(), {**CLAIM_RULES, "map_method": method})
+    other = ({"rsmhp_nt100", "rsmhp_nt250"} - {compared}).pop()
+    for cid, limited in (("DEC-8a", True), ("DEC-8b", False)):
+        c = claims[cid]
+        assert c.verdict == verdict
+        g = groups[(groups["limited"] == limited) & (groups["comparison"] == f"{compared} − nbo")]
+        assert (c.key.value, c.key.ci_low, c.key.ci_high) == tuple(
+            g.iloc[0][["mean_diff", "ci_low", "ci_high"]]
+        )
+        assert f"N_T={compared[len('rsmhp_nt') :]}" in c.claim
+        assert f"N_T={other[len('rsmhp_nt') :]}" in c.dropped
+        # N_T=250 is worse than NBO in every cell: named as contrary whichever is compared
+        assert "RS-MHP N_T=250 − NBO = +" in c.contrary
+        assert "RS-MHP N_T=100 − NBO" not in c.contrary
+        assert "decisions.claims.map_method" in c.measured
+    assert dec_claims.map_comparison(m, method) == (f"{compared} − nbo", [other])
+
+
+def test_a_map_method_not_in_the_map_is_refused():
+    runs = _two_members()
+    for name in ("rsmhp_nt999", "nbo"):  # not run; the baseline is no comparison
+        with pytest.raises(ValueError, match=r"decisions\.claims\.map_method = '" + name):
+            _map_claims(runs, {**CLAIM_RULES, "map_method": name})
+    m, _, _ = _map_claims(runs)
+    with pytest.raises(ValueError, match=r"allowed: rsmhp_nt100, rsmhp_nt250"):
+        dec_claims.map_comparison(m, "rsmhp_nt999")
+    # a map without an RS-MHP comparison gives no DEC-8 by default
+    tree = m.assign(comparison=m["comparison"].str.replace("rsmhp_nt", "tree_n8_m"))
+    assert dec_claims.map_comparison(tree) is None
+    # and the config check refuses it before any run, naming the field
+    cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    assert cfg["decisions"]["claims"]["map_method"] == "rsmhp_nt100"
+    check_config(cfg)
+    cfg["decisions"]["claims"]["map_method"] = "rsmhp_nt999"
+    with pytest.raises(ValueError, match=r"decisions\.claims\.map_method: 'rsmhp_nt999'"):
+        check_config(cfg)
+
+
+def test_map_contrary_names_cells_whose_ci_lies_above_zero():
+    m = pd.DataFrame(
+        {
+            "row_key": ["sensor.footprint_radius"] * 5,
+            "row_value": [150.0, 120.0, 300.0, 200.0, None],
+            "col_key": ["target.q"] * 5,
+            "col_value": [1.0, 4.0, 16.0, 0.25, 1.0],
+            "comparison": ["rsmhp_nt100 − nbo"] * 4 + ["rsmhp_nt250 − nbo"],
+            "mean_diff": [0.5, 0.2, -0.3, 0.4, 0.9],
+            "ci_low": [0.1, -0.1, -0.5, 0.0, 0.6],
+            "ci_high": [0.9, 0.5, -0.1, 0.8, 1.2],
+        }
+    )
+    limited = dec.limited_cells(m)
+    text = dec_claims.map_contrary(m, limited, True, "rsmhp_nt100")
+    assert "footprint radius (m) 150, target manoeuvrability q (m²/s³) 1:" in text  # above 0
+    assert "RS-MHP N_T=100 − NBO = +0.5" in text
+    assert "footprint radius (m) 120" not in text  # the CI contains 0
+    assert "footprint radius (m) 300" not in text  # below 0: RS-MHP better
+    assert "footprint radius (m) 200" not in text  # the CI touches 0: not above it
+    assert "unlimited" not in text  # the other group
+    assert text.count(";") == 0  # one cell named
+    other = dec_claims.map_contrary(m, limited, False, "rsmhp_nt100")
+    assert other.startswith("footprint radius (m) unlimited") and "N_T=250" in other
+    assert dec_claims.map_contrary(m.assign(ci_low=-1.0), limited, True, "rsmhp_nt100") == ""
+
+
+def test_base_limited_decides_the_group_of_cells_without_a_footprint_axis():
+    """A map over q and the initial sd: every cell has the base config's sensor, so all of
+    them are DEC-8a (base footprint) or all DEC-8b, contrary cells included."""
+    runs = _map_runs(2.0).assign(row_value=lambda d: d["cell"].map({"r0c0": 1.0, "r1c0": 4.0}))
+    cfg = {"rows": {"key": "target.q"}, "cols": {"key": "tracker.p0_pos_sd"}}
+    for base_limited, cid in ((True, "DEC-8a"), (False, "DEC-8b")):
+        _, _, claims = _map_claims(runs, cfg=cfg, base_limited=base_limited)
+        assert list(claims) == [cid]
+        assert claims[cid].verdict == "not supported"
+        assert claims[cid].contrary.count("target manoeuvrability q (m²/s³)") == 2
 
 
 def _regret_rows(spec: dict, n_runs: int = 10, seed: int = 2) -> pd.DataFrame:
@@ -249,12 +360,23 @@ def _regret_rows(spec: dict, n_runs: int = 10, seed: int = 2) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=REGRET_COLUMNS)
 
 
-def _regret_claims(spec: dict) -> dict:
+def _regret_claims(spec: dict, rules=CLAIM_RULES) -> dict:
     df = _regret_rows(spec)
     summary = dec.summarize_uav_regret(df, 1, 500)
     empty = pd.DataFrame(columns=dec.MAP_GROUP_COLUMNS)
-    claims = dec_claims.uav_claims(df, summary, pd.DataFrame(), empty, 1, 500)
+    claims = dec_claims.uav_claims(df, summary, pd.DataFrame(), empty, rules, 1, 500)
     return {c.id: c for c in claims}
+
+
+def _holds(verdict: str, lo: float, hi: float, margin: float) -> bool:
+    """Whether the CI [lo, hi] (pp) meets the condition of ``verdict`` under regret_rule."""
+    inside = -margin < lo and hi < margin
+    return {
+        "equivalent": inside,
+        "supported": not inside and lo > 0,
+        "not supported": not inside and hi < 0,
+        "inconclusive": not inside and lo <= 0 <= hi,
+    }[verdict]
 
 
 def test_regret_summary_and_claims():
@@ -265,12 +387,15 @@ def test_regret_summary_and_claims():
     fp = summary[(summary.model == "fp150") & (summary.method == "nbo")].iloc[0]
     assert np.isnan(fp["spearman_random"]) and fp["spearman_random_undefined"] == 20
     c = _regret_claims({"paper": (0.001, 0.001, 0.0002), "fp150": (0.05, 0.001, 0.01)})
-    assert c["DEC-6"].verdict == "supported"  # NBO within the margin of RS-MHP
+    assert c["DEC-6"].verdict == "equivalent"  # NBO within ±0.1 pp of RS-MHP
     assert c["DEC-7-fp150"].verdict == "supported"  # RS-MHP decides better with the footprint
     k6, k7 = c["DEC-6"].key, c["DEC-7-fp150"].key
     assert k6.unit == k7.unit == "pp" and k6.reproducible == k7.reproducible == "statistical"
-    assert k6.null is None  # an equivalence claim has no single opposite value
-    assert k7.null == 0.0
+    assert k6.null == k7.null == 0.0  # both the same directional claim
+    assert -0.1 < k6.ci_low and k6.ci_high < 0.1
+    assert c["DEC-6"].part == "paper" and c["DEC-7-fp150"].part == "beyond"
+    assert c["DEC-6"].setup.startswith("UAV reconstruction 'paper'")
+    assert c["DEC-7-fp150"].setup.startswith("UAV variant 'fp150'")
     g = df[df.model == "fp150"].pivot_table(
         index=["run", "step"], columns="method", values="regret_rel"
     )
@@ -282,29 +407,48 @@ def test_regret_summary_and_claims():
 @pytest.mark.parametrize(
     "nbo, rs, sd, verdict",
     [
-        (0.010, 0.010, 0.0005, "supported"),  # equal: CI well inside ±0.5 pp
-        (0.030, 0.010, 0.0005, "not supported"),  # 2 pp apart: CI outside the margin
-        (0.015, 0.010, 0.0020, "inconclusive"),  # 0.5 pp apart: CI straddles the margin
-        (0.010, 0.030, 0.0005, "not supported"),  # NBO better by 2 pp: also not equivalent
+        (0.010, 0.010, 0.0005, "equivalent"),  # equal: CI well inside ±0.1 pp
+        (0.0106, 0.010, 0.0002, "equivalent"),  # CI above 0 yet inside ±0.1 pp: negligible
+        (0.030, 0.010, 0.0005, "supported"),  # RS-MHP 2 pp better
+        (0.010, 0.030, 0.0005, "not supported"),  # NBO 2 pp better
+        (0.010, 0.010, 0.0020, "inconclusive"),  # CI contains 0 and leaves ±0.1 pp
     ],
 )
-def test_dec6_equivalence_rule(nbo, rs, sd, verdict):
+def test_dec6_directional_rule_with_margin(nbo, rs, sd, verdict):
     c = _regret_claims({"paper": (nbo, rs, sd)})["DEC-6"]
     assert c.verdict == verdict
-    margin = 100 * dec_claims.EQUIVALENCE_MARGIN
-    inside = -margin < c.key.ci_low and c.key.ci_high < margin
-    assert inside == (verdict == "supported")
-    assert f"±{margin:g} percentage points" in c.rule  # the rule prints the constant
-    assert c.rule == dec_claims.DEC6_RULE.text()
+    assert _holds(verdict, c.key.ci_low, c.key.ci_high, 0.1)
+    assert c.rule == dec_claims.regret_rule(0.1, "the reconstruction").text()
+    assert "inside ±0.1 pp" in c.rule and "entirely above 0" in c.rule  # the margin is printed
+    assert "±0.1 pp fixed in the config" in c.measured
 
 
 @pytest.mark.parametrize(
-    "nbo, rs, verdict",
-    [(0.03, 0.01, "supported"), (0.01, 0.03, "not supported"), (0.01, 0.01, "inconclusive")],
+    "nbo, rs, sd, verdict",
+    [
+        (0.03, 0.01, 0.002, "supported"),
+        (0.01, 0.03, 0.002, "not supported"),
+        (0.01, 0.01, 0.002, "inconclusive"),
+        (0.01, 0.01, 0.0005, "equivalent"),
+    ],
 )
-def test_dec7_sign_rule(nbo, rs, verdict):
-    c = _regret_claims({"paper": (0.01, 0.01, 0.001), "fp": (nbo, rs, 0.002)})["DEC-7-fp"]
+def test_dec7_is_the_same_claim_on_a_variant(nbo, rs, sd, verdict):
+    c = _regret_claims({"paper": (0.01, 0.01, 0.001), "fp": (nbo, rs, sd)})["DEC-7-fp"]
     assert c.verdict == verdict
+    assert _holds(verdict, c.key.ci_low, c.key.ci_high, 0.1)
+    assert c.rule == dec_claims.regret_rule(0.1, "the model variant").text()
+    assert c.part == "beyond" and "chooses better plans than NBO" in c.claim
+
+
+def test_the_margin_comes_from_the_config():
+    """RS-MHP 2 pp better: supported with the default margin, equivalent within ±5 pp."""
+    spec = {"paper": (0.03, 0.01, 0.0005), "fp": (0.03, 0.01, 0.0005)}
+    assert {c.verdict for c in _regret_claims(spec).values()} == {"supported"}
+    wide = _regret_claims(spec, {**CLAIM_RULES, "equivalence_margin_pp": 5})
+    for c in wide.values():
+        assert c.verdict == "equivalent" and "±5 pp" in c.rule and 0 < c.key.ci_low
+    with pytest.raises(ValueError, match="margin must be a number > 0"):
+        _regret_claims(spec, {**CLAIM_RULES, "equivalence_margin_pp": 0})
 
 
 NAN_INF = re.compile(r"\b(nan|inf)\b", re.IGNORECASE)
@@ -329,6 +473,7 @@ SECTION_CFG = {
         "regret_runs": 1,
         "regret_steps": [0],
     },
+    "claims": {"equivalence_margin_pp": 0.1, "map_method": "rsmhp_nt100"},
 }
 
 
@@ -369,16 +514,18 @@ def test_section_budget_and_text():
 def test_claims_fit_the_ledger():
     _, _, _, section = _section()
     rules = {
-        "DEC-6": dec_claims.DEC6_RULE,
-        "DEC-7-fp150": dec_claims.DEC7_RULE,
+        "DEC-6": dec_claims.regret_rule(0.1, "the reconstruction"),
+        "DEC-7-fp150": dec_claims.regret_rule(0.1, "the model variant"),
         "DEC-8a": dec_claims.DEC8_RULE,
         "DEC-8b": dec_claims.DEC8_RULE,
     }
     for c in section.claims:
-        assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300, c.id
+        # the claim carries its scope (220); DEC-8's rule names its config field (343)
+        assert len(c.claim) <= 220 and len(c.paper) <= 150 and len(c.rule) <= 450, c.id
         assert c.rule == rules[c.id].text()
         assert c.key.reproducible == "statistical" and c.key.has_ci
-        for text in (c.claim, c.paper, c.key.text(), c.measured, c.dropped):
+        assert c.part == ("paper" if c.id == "DEC-6" else "beyond") and c.setup.strip()
+        for text in (c.claim, c.paper, c.key.text(), c.measured, c.dropped, c.contrary):
             assert not NAN_INF.search(text)
 
 
@@ -431,50 +578,60 @@ def test_limited_cells_follow_the_axis_else_the_base_sensor():
     assert dec.limited_cells(m, base_limited=True).tolist() == [False, True, True, True]
 
 
-@pytest.mark.parametrize(
-    "lo, hi, verdict",
-    [
-        (-0.49, 0.49, "supported"),  # inside ±0.5 pp
-        (-0.5, 0.2, "inconclusive"),  # touches the margin: not inside
-        (0.2, 0.5, "inconclusive"),
-        (0.4, 0.6, "inconclusive"),  # straddles it
-        (-0.6, 0.6, "inconclusive"),  # wider than the margin on both sides
-        (0.5, 0.9, "not supported"),  # entirely at or beyond +0.5 pp
-        (-0.9, -0.5, "not supported"),
-    ],
-)
-def test_dec6_rule_boundaries(lo, hi, verdict):
+REGRET_RULE_FACTS = [  # margin 0.5 pp
+    (-0.49, 0.49, "equivalent"),  # inside ±0.5 pp
+    (0.01, 0.49, "equivalent"),  # above 0 yet inside the margin: a negligible difference
+    (-0.49, -0.01, "equivalent"),
+    (0.0, 0.4, "equivalent"),  # at 0, inside the margin
+    (-0.5, 0.2, "inconclusive"),  # touches -m: not inside; contains 0
+    (-0.6, 0.6, "inconclusive"),  # wider than the margin on both sides
+    (0.0, 0.5, "inconclusive"),  # exactly at 0 and touching +m
+    (-1.0, 0.0, "inconclusive"),  # exactly at 0 from below
+    (0.2, 0.5, "supported"),  # touches +m: not inside; above 0
+    (0.4, 0.6, "supported"),  # straddles +m, above 0
+    (1e-12, 1.0, "supported"),
+    (-0.9, -0.5, "not supported"),  # touches -m from outside
+    (-1.0, -1e-12, "not supported"),
+]
+
+
+@pytest.mark.parametrize("lo, hi, verdict", REGRET_RULE_FACTS)
+def test_regret_rule_boundaries(lo, hi, verdict):
     facts = {f"{dec_claims.KEY}_low": lo, f"{dec_claims.KEY}_high": hi}
-    assert dec_claims.DEC6_RULE.verdict(facts) == verdict
+    rule = dec_claims.regret_rule(0.5, "the reconstruction")
+    assert rule.verdict(facts) == verdict
+    # the same facts from a key number with that CI (as DEC-6/DEC-7 build them)
+    key = KeyNumber("d", (lo + hi) / 2, lo, hi, unit="pp", reproducible="statistical")
+    assert rule.verdict(dec_claims.ci_facts(key)) == verdict
 
 
-@pytest.mark.parametrize(
-    "lo, hi, verdict",
-    [
-        (1e-12, 1.0, "supported"),
-        (0.0, 1.0, "inconclusive"),  # touches 0
-        (-1.0, 0.0, "inconclusive"),
-        (-1.0, -1e-12, "not supported"),
-    ],
-)
-def test_dec7_rule_boundaries(lo, hi, verdict):
-    facts = {f"{dec_claims.KEY}_low": lo, f"{dec_claims.KEY}_high": hi}
-    assert dec_claims.DEC7_RULE.verdict(facts) == verdict
+def test_regret_rule_gives_each_of_its_verdicts():
+    rule = dec_claims.regret_rule(0.5, "the model variant")
+    assert rule.verdicts == ("equivalent", "supported", "not supported", "inconclusive")
+    assert {v for _, _, v in REGRET_RULE_FACTS} == set(rule.verdicts)
+    assert "±0.5 pp" in rule.text() and "the model variant" in rule.text()
+    with pytest.raises(ValueError, match="margin must be a number > 0"):
+        dec_claims.regret_rule(0.0, "the reconstruction")
 
 
-@pytest.mark.parametrize(
-    "below, above, lo, hi, verdict",
-    [
-        (2, 0, -1.0, -1e-12, "supported"),  # every cell and the pooled mean below 0
-        (2, 0, -1.0, 0.0, "inconclusive"),  # the pooled CI touches 0
-        (1, 0, -1.0, -0.5, "inconclusive"),  # one cell undecided
-        (1, 1, -1.0, -0.5, "not supported"),  # one cell above 0
-        (0, 0, 1e-12, 1.0, "not supported"),  # the pooled mean above 0
-        (0, 0, 0.0, 1.0, "inconclusive"),
-    ],
-)
+DEC8_FACTS = [
+    (2, 0, -1.0, -1e-12, "supported"),  # every cell and the pooled mean below 0
+    (2, 0, -1.0, 0.0, "inconclusive"),  # the pooled CI touches 0
+    (1, 0, -1.0, -0.5, "inconclusive"),  # one cell undecided
+    (1, 1, -1.0, -0.5, "not supported"),  # one cell above 0
+    (0, 0, 1e-12, 1.0, "not supported"),  # the pooled mean above 0
+    (0, 0, 0.0, 1.0, "inconclusive"),
+]
+
+
+@pytest.mark.parametrize("below, above, lo, hi, verdict", DEC8_FACTS)
 def test_dec8_rule_boundaries(below, above, lo, hi, verdict):
     group = pd.Series(
         {"n_cells": 2, "n_below": below, "n_above": above, "ci_low": lo, "ci_high": hi}
     )
     assert dec_claims.DEC8_RULE.verdict(dec_claims.map_facts(group)) == verdict
+
+
+def test_dec8_rule_gives_each_of_its_verdicts():
+    assert {f[-1] for f in DEC8_FACTS} == set(dec_claims.DEC8_RULE.verdicts)
+    assert "decisions.claims.map_method" in dec_claims.DEC8_RULE.text()

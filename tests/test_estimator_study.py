@@ -147,25 +147,73 @@ def summary(ablation, problems) -> pd.DataFrame:
     return analysis.summarize_ablation(ablation, problems, seed=11)
 
 
-def test_verdicts_follow_the_data(ablation, summary):
+KS = [1.5, 2.0, 3.0]
+
+#: text budgets of a claim (ledger v2: claims state their scope, rules their exceedance tests)
+CLAIM_MAX, PAPER_MAX, RULE_MAX = 200, 160, 650
+
+
+@pytest.fixture(scope="module")
+def cheb(ablation, summary, problems) -> pd.DataFrame:
+    return analysis.chebyshev_table(ablation, summary, KS, problems)
+
+
+def test_chebyshev_table_counts_and_exact_probabilities(ablation, summary, problems, cheb):
+    # plain MC, uniform: one row per (problem, n, k)
+    assert len(cheb) == 2 * 2 * len(KS)
+    assert {"replicates", "hits", "exact", "detectable", "bound", "freq"} <= set(cheb.columns)
+    assert (cheb["replicates"] == CFG["replicates"]).all()
+    np.testing.assert_allclose(cheb["freq"], cheb["hits"] / cheb["replicates"])
+    np.testing.assert_allclose(cheb["bound"], [min(1.0, 1 / k**2) for k in cheb["k"]])
+    theory = analysis.select(summary, "mc").set_index(["problem", "n_trajectories"])
+    for _, r in cheb.iterrows():
+        sd = float(np.sqrt(theory.loc[(r["problem"], r["n"]), "var_theory"]))
+        form = problems[r["problem"]].quadratic_form
+        assert r["exact"] == pytest.approx(form.mean_error_tail(int(r["n"]), r["k"] * sd))
+        assert 0 < r["exact"] < r["bound"]  # Chebyshev holds, far from tight
+        raw = ablation[
+            (ablation["problem"] == r["problem"])
+            & (ablation["scheme"] == "mc")
+            & (ablation["weighting"] == "uniform")
+            & (ablation["n_trajectories"] == r["n"])
+        ]
+        assert r["hits"] == int(np.sum(np.abs(raw["estimate"] - raw["J_exact"]) >= r["k"] * sd))
+        assert r["detectable"] > 0  # 40 replicates: at best a coarse resolution
+
+
+def test_verdicts_follow_the_data(summary, cheb):
     s = summary
-    claims = est_claims.claims(ablation, s, [2.0])
+    claims = est_claims.claims(s, cheb)
     by_id = {c.id: c for c in claims}
     assert list(by_id) == ["EST-1", "EST-2", "EST-3", "EST-4"]
     # every key number of this study is bitwise reproducible (seeded draws and bootstrap)
     assert all(c.key.reproducible == "bitwise" for c in claims)
+    assert all(c.part == "paper" and c.setup == est_claims.SETUP for c in claims)
     # weighted tree estimates move to J(Σ/2), far from J: Prop. 2 is rejected
     assert by_id["EST-2"].verdict == "not supported"
     assert by_id["EST-2"].key.ci_low > 0.5 and by_id["EST-2"].key.null == 1.0
-    # pruned estimates approach NBO at N = 16
-    assert by_id["EST-4"].verdict == "not supported"
-    # a fake table in which the pruned estimator is exact must flip EST-4 to supported
+    # two budgets give no Var-vs-n slope: EST-3 cannot be supported
+    assert est_claims.facts_est3(cheb, s)["slopes"] == 0
+    assert by_id["EST-3"].verdict == "inconclusive"
+    # pruned estimates approach NBO at N = 16: every CI lies above 0, pruning degrades J's
+    # approximation as the paper states
+    top = analysis.pruning_at_largest_n(s)
+    assert (top["bias_fraction_low"] > 0).all()
+    c4 = by_id["EST-4"]
+    assert c4.verdict == "supported" and c4.key.null == 0.0 and c4.key.ci_low > 0
+    # the key number is the weakest evidence: the cell whose CI reaches nearest to J
+    assert c4.key.ci_low == top["bias_fraction_low"].min()
+    # a fake table in which the pruned estimator is exact: no degradation, not supported
     fake = s.copy()
     pr = fake["scheme"] == "pruned"
     fake.loc[pr, "bias_fraction_of_nbo"] = 0.0
     fake.loc[pr, "bias_fraction_low"] = -0.01
     fake.loc[pr, "bias_fraction_high"] = 0.01
-    assert est_claims.claim_est4(fake).verdict == "supported"
+    assert est_claims.claim_est4(fake).verdict == "not supported"
+    # one cell whose CI contains 0 among degraded ones: inconclusive
+    one = s.copy()
+    one.loc[top.index[0], ["bias_fraction_low", "bias_fraction_high"]] = [-0.01, 0.5]
+    assert est_claims.claim_est4(one).verdict == "inconclusive"
     # a tree whose variance grows with N contradicts Prop. 1
     bad = s.copy()
     tree = (bad["scheme"] == "tree") & (bad["weighting"] == "uniform")
@@ -173,6 +221,42 @@ def test_verdicts_follow_the_data(ablation, summary):
     bad.loc[tree, "var_low"] = bad.loc[tree, "var"] * 0.9
     bad.loc[tree, "var_high"] = bad.loc[tree, "var"] * 1.1
     assert est_claims.claim_est1(bad).verdict == "not supported"
+
+
+@pytest.fixture(scope="module")
+def mc_study(problems):
+    """Plain MC only, at three budgets (a Var-vs-n slope per problem), 200 replicates."""
+    cfg = {**CFG, "budgets": [16, 32, 64], "schemes": ["mc"], "replicates": 200}
+    df = run_ablation(cfg, MODEL, seed=11)
+    return df, analysis.summarize_ablation(df, problems, seed=11)
+
+
+def test_est3_follows_the_exceedances(mc_study, problems):
+    df, s = mc_study
+    cheb = analysis.chebyshev_table(df, s, KS, problems)
+    assert len(cheb) == 2 * 3 * len(KS) and (cheb["replicates"] == 200).all()
+    facts = est_claims.facts_est3(cheb, s)
+    assert facts["slopes"] == 2 and facts["slopes_off"] == 0
+    assert (facts["departing"], facts["above bound"], facts["exact above bound"]) == (0, 0, 0)
+    c = est_claims.claim_est3(s, cheb)
+    assert c.verdict == "supported" and c.key.value >= 0.05
+    assert f"({len(cheb)} cells)" in c.key.name and c.key.null is None
+    assert "0 of 18 cells depart from the exact probability" in c.measured
+    assert "variance slope vs n: lqg_paper" in c.measured and "ncv2" in c.measured
+    assert c.rule == est_claims.rule_est3(KS).text()
+    # errors 1.5 times too wide: most counts depart from the exact probability, but none
+    # exceeds Chebyshev's bound significantly: inconclusive
+    wide = df.assign(estimate=df["J_exact"] + 1.5 * (df["estimate"] - df["J_exact"]))
+    cw = analysis.chebyshev_table(wide, s, KS, problems)
+    fw = est_claims.facts_est3(cw, s)
+    assert fw["departing"] >= 1 and fw["above bound"] == 0
+    cw_claim = est_claims.claim_est3(s, cw)
+    assert cw_claim.verdict == "inconclusive" and cw_claim.key.value < 0.05
+    # three times too wide: significantly above 1/k², not supported
+    wider = df.assign(estimate=df["J_exact"] + 3.0 * (df["estimate"] - df["J_exact"]))
+    cw3 = analysis.chebyshev_table(wider, s, KS, problems)
+    assert est_claims.facts_est3(cw3, s)["above bound"] >= 1
+    assert est_claims.claim_est3(s, cw3).verdict == "not supported"
 
 
 # --- verdict rules on synthetic summaries with known answers ------------------------------
@@ -326,9 +410,9 @@ def _table_cells(md: str) -> list[dict[str, str]]:
 
 
 @pytest.fixture(scope="module")
-def section(ablation, summary):
-    tabs = narrative.tables(ablation, summary, [1.5, 2.0, 3.0])
-    return narrative.estimators_section(ablation, summary, [1.5, 2.0, 3.0], tabs), tabs
+def section(ablation, summary, cheb):
+    tabs = narrative.tables(ablation, summary, cheb)
+    return narrative.estimators_section(ablation, summary, cheb, tabs), tabs
 
 
 def test_section_body_budget_and_clean_numbers(section):
@@ -350,7 +434,13 @@ def test_section_body_budget_and_clean_numbers(section):
         assert not DOT_ZERO.search(text), DOT_ZERO.search(text)
     assert "k in {1.5, 2, 3}" in sec.claims[2].rule
     for c in sec.claims:
-        assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300
+        assert len(c.claim) <= CLAIM_MAX and len(c.paper) <= PAPER_MAX, c.id
+        assert len(c.rule) <= RULE_MAX, c.id
+    # the Chebyshev table of the appendix: the exact probability beside the bound, largest n
+    rows = _table_cells(tabs["est_chebyshev"])
+    assert len(rows) == 2 * len(KS) and {r["n"] for r in rows} == {"64"}
+    assert all(float(r["exact"]) < float(r["bound 1/k²"]) for r in rows)
+    assert "the exact probability (a generalised chi-square) lies at" in sec.body
     integer_cols = {"n", "N", "M", "H", "leaves", "n reached"}
     for stem, md in tabs.items():
         for row in _table_cells(md):
@@ -509,44 +599,88 @@ def test_est2_rule_boundaries(facts, verdict):
     assert est_claims.RULE_EST2.verdict(facts) == verdict
 
 
+EST3_OK = {
+    "cells": 18,
+    "departing": 0,
+    "above bound": 0,
+    "exact above bound": 0,
+    "detectable": 0.2,
+    "slopes": 2,
+    "slopes_off": 0,
+}
+
+
 @pytest.mark.parametrize(
-    ("facts", "verdict"),
+    ("change", "verdict"),
     [
-        ({"cells": 4, "above": 0, "under": 4, "slopes": 2, "slopes_off": 0}, "supported"),
-        # an upper limit equal to its bound is not "below" it
-        ({"cells": 4, "above": 0, "under": 3, "slopes": 2, "slopes_off": 0}, "inconclusive"),
-        ({"cells": 4, "above": 0, "under": 4, "slopes": 0, "slopes_off": 0}, "inconclusive"),
-        ({"cells": 4, "above": 1, "under": 3, "slopes": 2, "slopes_off": 0}, "not supported"),
-        ({"cells": 4, "above": 0, "under": 4, "slopes": 2, "slopes_off": 1}, "not supported"),
+        ({}, "supported"),
+        ({"departing": 1}, "inconclusive"),  # a count departs from the exact probability
+        ({"exact above bound": 1}, "inconclusive"),
+        ({"slopes": 0}, "inconclusive"),  # no Var-vs-n slope to check the 1/n rate
+        ({"cells": 0}, "inconclusive"),
+        ({"above bound": 1}, "not supported"),
+        ({"slopes_off": 1}, "not supported"),  # a slope CI excludes -1
+        ({"slopes_off": 1, "departing": 1, "slopes": 1}, "not supported"),
+        ({"above bound": 1, "slopes": 0}, "not supported"),
     ],
 )
-def test_est3_rule_boundaries(facts, verdict):
-    assert est_claims.rule_est3([2.0]).verdict(facts) == verdict
+def test_est3_rule_boundaries(change, verdict):
+    assert est_claims.rule_est3([2.0]).verdict({**EST3_OK, **change}) == verdict
+
+
+def test_est3_rule_extends_the_exceedance_rule():
+    from rsmhp.claims.lqg import exceedance_rule
+
+    base = exceedance_rule("")
+    rule = est_claims.rule_est3([1.5, 2.0])
+    assert rule.verdicts == ("not supported", "supported", "inconclusive")
+    assert rule.cases[0].when.startswith(base.cases[0].when)
+    assert rule.cases[1].when.startswith(base.cases[1].when)
+    assert "k in {1.5, 2}" in rule.text()
 
 
 def _pruned_top(lows_highs: list[tuple[float, float]]) -> pd.DataFrame:
     return pd.DataFrame(
-        [{"bias_fraction_low": lo, "bias_fraction_high": hi} for lo, hi in lows_highs]
+        [{"bias_fraction_low": lo, "bias_fraction_high": hi} for lo, hi in lows_highs],
+        columns=["bias_fraction_low", "bias_fraction_high"],
     )
 
 
 @pytest.mark.parametrize(
     ("cis", "verdict"),
     [
-        ([(-0.1, 0.1), (0.0, 0.99)], "supported"),  # CI touching 0 contains it
-        ([(-0.1, 0.1), (0.0, 1.0)], "inconclusive"),  # a CI reaching 1 does not exclude it
-        ([(0.5, 0.9)], "inconclusive"),  # lower limit at 0.5 is not above it
-        ([(-0.1, 0.1), (0.5000001, 0.9)], "not supported"),
+        ([(0.01, 0.5), (1e-12, 0.9)], "supported"),  # every CI strictly above 0
+        ([(0.9, 1.1)], "supported"),  # at the NBO cost: degraded all the way
+        ([(0.0, 0.5), (0.2, 0.9)], "inconclusive"),  # a CI touching 0 contains it
+        ([(0.0, 0.5)], "not supported"),  # ... touching 0 from above
+        ([(-0.5, 0.0)], "not supported"),  # ... and from below
+        ([(-0.1, 0.1), (-0.2, 0.3)], "not supported"),
+        ([(-0.3, -0.1)], "inconclusive"),  # biased away from the NBO cost: neither
+        ([(-0.3, -0.1), (0.1, 0.2)], "inconclusive"),
         ([], "inconclusive"),
     ],
 )
 def test_est4_rule_boundaries(cis, verdict):
-    top = (
-        _pruned_top(cis)
-        if cis
-        else _pruned_top([]).reindex(columns=["bias_fraction_low", "bias_fraction_high"])
-    )
-    assert est_claims.RULE_EST4.verdict(est_claims.facts_est4(top)) == verdict
+    assert est_claims.RULE_EST4.verdict(est_claims.facts_est4(_pruned_top(cis))) == verdict
+
+
+def test_est4_facts_and_key_number():
+    top = _pruned_top([(0.0, 0.5), (0.2, 0.9), (-0.3, -0.1), (-0.1, 0.1)])
+    assert est_claims.facts_est4(top) == {"cells": 4, "above_zero": 1, "contain_zero": 2}
+    # the claim on a synthetic summary: the key number is the cell whose CI reaches nearest J
+    rows = [
+        {"problem": "p", "scheme": "pruned", "weighting": "uniform", "N": N, "M": M, "H": 2,
+         "bias_fraction_of_nbo": f, "bias_fraction_low": f - 0.1, "bias_fraction_high": f + 0.1}
+        for N, M, f in ((4, 1, 0.05), (16, 1, 0.9), (16, 2, 0.3), (16, 4, 0.6))
+    ]  # fmt: skip
+    c = est_claims.claim_est4(pd.DataFrame(rows))
+    assert c.verdict == "supported"  # at N = 16 every CI lies above 0; N = 4 is not counted
+    assert "N = 16 M = 2" in c.key.name and c.key.value == 0.3 and c.key.null == 0.0
+    assert c.key.ci_low == pytest.approx(0.2)
+    assert "below the largest N" in c.dropped
+    rows[2] |= {"bias_fraction_of_nbo": 0.05, "bias_fraction_low": -0.05}
+    c = est_claims.claim_est4(pd.DataFrame(rows))
+    assert c.verdict == "inconclusive" and "N = 16 M = 2" in c.key.name
 
 
 def test_printed_rules_come_from_the_rule_objects(section):
@@ -554,7 +688,7 @@ def test_printed_rules_come_from_the_rule_objects(section):
     rules = [
         est_claims.RULE_EST1,
         est_claims.RULE_EST2,
-        est_claims.rule_est3([1.5, 2.0, 3.0]),
+        est_claims.rule_est3(KS),
         est_claims.RULE_EST4,
     ]
     assert [c.rule for c in sec.claims] == [r.text() for r in rules]

@@ -14,17 +14,43 @@ import pandas as pd
 import pytest
 
 from rsmhp import verify as vfy
+from rsmhp.claims.paper import Statement
 from rsmhp.ledger import Claim, KeyNumber, Section, claims_records
 from rsmhp.markdown import fmt, fmt_ci, markdown_table
 from rsmhp.readme import MARK_BEGIN, MARK_END, splice
 from rsmhp.report import glance_table, render_appendix, render_report
 
+#: the statements the constructed claims below are evidence for
+STATEMENTS = (
+    Statement("S1", "Sec. I", "A beats B", ("A-*",)),
+    Statement("S2", "Sec. II", "C may fail", ("Z-1", "V-1"), hedged=True, note="a note"),
+)
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _claim(cid="X-1", verdict="inconclusive", value=0.1, lo=-0.2, hi=0.4, repro="statistical"):
+def _claim(
+    cid="X-1",
+    verdict="inconclusive",
+    value=0.1,
+    lo=-0.2,
+    hi=0.4,
+    repro="statistical",
+    part="paper",
+    contrary="",
+):
     key = KeyNumber("paired difference", value, lo, hi, "m", repro, null=0.0)
-    return Claim(cid, "A beats B", "Sec. I: A beats B", key, verdict, "CI below 0: supported")
+    return Claim(
+        cid,
+        "A beats B",
+        "Sec. I: A beats B",
+        key,
+        verdict,
+        "CI below 0: supported",
+        part=part,
+        setup=f"setup of {cid}",
+        contrary=contrary,
+    )
 
 
 # ---------------------------------------------------------------- formatting
@@ -127,18 +153,23 @@ def test_section_roundtrip_and_rendering(tmp_path):
     with pytest.raises(ValueError, match="not a valid report section"):
         Section.load(tmp_path / "bad.json")
     prov = {"commit": "abc", "config sha256": "0123", "numpy": "2"}
-    main = render_report([a, b], prov)
+    main = render_report([a, b], prov, statements=STATEMENTS)
     assert main.index("## Earlier study") < main.index("## Later study")
     assert main.index("## Claims ledger") < main.index("## Earlier study")
-    assert "2 claims: 1 supported, 0 not supported, 1 inconclusive" in main
-    assert "1 key numbers are bitwise reproducible" in main
-    assert (
-        "| A-1 | A beats B | Sec. I: A beats B | paired difference: -0.300 [-0.500, -0.100] m"
-        in main
-    )
+    # part 1: each statement once with its verdict from its evidence; part 2 apart
+    assert "2 statements of the paper" in main and "(2 claims of evidence)" in main
+    assert "1 supported, 0 not supported, 0 equivalent, 1 inconclusive" in main
+    assert "| S1 | A beats B (Sec. I) | setup of A-1 (A-1: supported) | **supported** |" in main
+    assert "| S2 | C may fail (Sec. II; hedged) | not shown on: setup of Z-1" in main
+    assert "- S2: a note" in main
+    assert "0 claims the report derives itself" in main
+    assert main.index("**Symbols.**") < main.index("### Part 1")
+    assert "1 of the 2 key numbers are bitwise reproducible" in main
+    assert "| A-1 | A beats B | setup of A-1 | paired difference: -0.300 [-0.500, -0.100] m" in main
     assert "CI below 0: supported" in main and "| t |" not in main
     app = render_appendix([a, b], {"seed": 2}, prov)
     assert "### Z-1 (inconclusive)" in app and "| t |" in app and "seed: 2" in app
+    assert "- Part: the paper; setup: setup of Z-1" in app
     assert (
         "(statistically reproducible)" in app
         and "(bitwise reproducible)" in app
@@ -147,8 +178,36 @@ def test_section_roundtrip_and_rendering(tmp_path):
     recs = claims_records([a, b])
     assert [r["id"] for r in recs] == ["A-1", "Z-1"]
     assert Claim.from_dict(json.loads(json.dumps(recs[1]))) == a.claims[0]
-    glance = glance_table([c for s in (b, a) for c in s.claims])
-    assert glance.count("\n") == 3 and "| Z-1 | A beats B |" in glance
+    glance = glance_table([c for s in (b, a) for c in s.claims], STATEMENTS)
+    assert glance.count("\n") == 3 and "| S2 | paper (Sec. II): C may fail |" in glance
+    # a claim of the paper that no statement lists is refused (it would be counted nowhere)
+    with pytest.raises(ValueError, match="Q-1"):
+        render_report(
+            [Section("q", "Q", 1, "b", claims=[_claim("Q-1")])], prov, statements=STATEMENTS
+        )
+
+
+def test_beyond_claims_and_contrary_evidence_are_in_part_two():
+    """Claims of part 'beyond' are counted apart; a variant listed under a general statement
+    is shown beside it but does not enter its verdict; contrary cells are printed."""
+    s = Section(
+        "s",
+        "Study",
+        1,
+        "Body.",
+        claims=[
+            _claim("A-1", "supported", -0.3, -0.5, -0.1),
+            _claim("A-2", "not supported", 0.3, 0.1, 0.5, contrary="cell q = 4: +0.26 m"),
+            _claim("V-1", "supported", -0.3, -0.5, -0.1, part="beyond"),
+        ],
+    )
+    stmts = (Statement("S1", "Sec. I", "A beats B", ("A-*", "V-1")),)
+    main = render_report([s], {}, statements=stmts)
+    assert "| S1 | A beats B (Sec. I) | setup of A-1 (A-1: supported); setup of A-2 (A-2: " in main
+    assert "**mixed**" in main  # A-1 supported, A-2 not supported: the evidence disagrees
+    assert "on variants, not counted: setup of V-1 (V-1: supported)" in main
+    assert "1 claims the report derives itself or tests on model variants: 1 supported" in main
+    assert "| cell q = 4: +0.26 m |" in main
 
 
 def test_splice_replaces_only_the_marked_block():
@@ -225,12 +284,15 @@ def test_published_report_matches_its_claims_and_the_readme():
     appendix = (ROOT / "paper/appendix.md").read_text(encoding="utf-8")
     data = json.loads((ROOT / "paper/claims.json").read_text(encoding="utf-8"))
     claims = [Claim.from_dict(c) for c in data["claims"]]
-    assert len(main.encode()) <= 25_000
+    # the two-part ledger with every rule and the contrary evidence next to its claim
+    assert len(main.encode()) <= 40_000
     for text in (main, appendix):
         assert not re.search(r"\b(nan|inf)\b", text, flags=re.IGNORECASE)
     for c in claims:
         assert f"| {c.id} | {c.claim.replace('|', chr(92) + '|')} |" in main
         assert f"### {c.id} ({c.verdict})" in appendix
+    for st in data["statements"]:
+        assert f"| {st['id']} | " in main and st["verdict"] in main
     ledger_ids = re.findall(r"^\| ([A-Z]+-[0-9A-Za-z-]+) \|", main, flags=re.MULTILINE)
     assert ledger_ids == [c.id for c in claims]
     readme = (ROOT / "README.md").read_text(encoding="utf-8")

@@ -128,24 +128,33 @@ def test_recording_contents_and_consistency(short_cfg, tmp_path):
         assert _det(s) == _det(ref)
 
 
-def _runs(diff: np.ndarray, tree: bool = False, base: np.ndarray | None = None) -> pd.DataFrame:
+def _runs(
+    diff: np.ndarray,
+    tree: bool = False,
+    base: np.ndarray | None = None,
+    mid: np.ndarray | None = None,
+    tree_seconds: float = 0.1,
+) -> pd.DataFrame:
     """Synthetic runs: NBO error ``base`` (default 10..20 m), RS-MHP N_T=50 ``base + diff``,
-    N_T=250 ``base + 2 diff`` and (``tree``) a pruned tree keeping 250, ``base + 3 diff``."""
+    N_T=250 ``base + 2 diff``, (``mid``) N_T=100 ``base + mid`` and (``tree``) a pruned tree
+    keeping 250, ``base + 3 diff``, planning ``tree_seconds`` per run (the others 0.1 s)."""
     n = diff.size
     base = np.linspace(10, 20, n) if base is None else base
     methods = [
-        ("nbo", "nbo", 1, 0, 0, base),
-        ("rsmhp_nt50", "rsmhp", 50, 0, 0, base + diff),
-        ("rsmhp_nt250", "rsmhp", 250, 0, 0, base + 2 * diff),
+        ("nbo", "nbo", 1, 0, 0, base, 0.1),
+        ("rsmhp_nt50", "rsmhp", 50, 0, 0, base + diff, 0.1),
+        ("rsmhp_nt250", "rsmhp", 250, 0, 0, base + 2 * diff, 0.1),
     ]
+    if mid is not None:
+        methods.append(("rsmhp_nt100", "rsmhp", 100, 0, 0, base + mid, 0.1))
     if tree:
-        methods.append(("tree_n8_m250", "tree", 250, 8, 250, base + 3 * diff))
+        methods.append(("tree_n8_m250", "tree", 250, 8, 250, base + 3 * diff, tree_seconds))
     rows = []
-    for name, fam, nt, N, M, err in methods:
+    for name, fam, nt, N, M, err, secs in methods:
         rows += [
             {"method": name, "family": fam, "N_T": nt, "N": N, "M": M, "run": r, "seed": 0,
              "mean_error": e, "rmse": e, "final_error": e, "mean_trace": 250.0, "mean_nit": 4.5,
-             "plan_seconds": 0.1}
+             "plan_seconds": secs}
             for r, e in enumerate(err)
         ]  # fmt: skip
     return pd.DataFrame(rows, columns=RUN_COLUMNS)
@@ -162,16 +171,32 @@ def _analyse(runs: pd.DataFrame, n_boot: int = 2000):
     return summary, paired
 
 
+#: the equivalence margin m of UAV-1..3 (config: uav.analysis.equivalence_margin)
+MARGIN = DEFAULT_UAV["analysis"]["equivalence_margin"]
+
+#: text budgets of a claim (ledger v2: claims state their scope)
+CLAIM_MAX, PAPER_MAX, RULE_MAX = 200, 160, 650
+
+
+def test_margin_is_configured():
+    assert MARGIN == 0.25
+
+
 @pytest.mark.parametrize(
-    ("shift", "verdict"),
-    [(-0.5, "supported"), (0.5, "not supported"), (0.0, "inconclusive")],
+    ("shift", "sd", "verdict"),
+    [
+        (-0.5, 0.3, "supported"),
+        (0.5, 0.3, "not supported"),
+        (0.0, 0.3, "equivalent"),  # CI half-width about 0.04 m, well inside ±0.25 m
+        (0.0, 3.0, "inconclusive"),  # CI half-width about 0.4 m: contains 0, exceeds ±m
+    ],
 )
-def test_verdict_rules(shift, verdict):
-    # differences shift + N(0, 0.3^2)-like spread (exactly centred), 200 runs: the bootstrap
-    # CI half-width is about 1.96 * 0.3 / sqrt(200) = 0.04, far from |shift| = 0.5
-    runs = _runs(shift + _centred_noise(200, 0.3), tree=True)
+def test_verdict_rules(shift, sd, verdict):
+    # differences shift + N(0, sd^2)-like spread (exactly centred), 200 runs: the bootstrap
+    # CI half-width is about 1.96 * sd / sqrt(200)
+    runs = _runs(shift + _centred_noise(200, sd), tree=True)
     summary, paired = _analyse(runs)
-    claims = {c.id: c for c in uav_claims.uav_claims(summary, paired)}
+    claims = {c.id: c for c in uav_claims.uav_claims(summary, paired, MARGIN)}
     # UAV-3: d = e(N_T=250) - e(tree) = -shift per run: the opposite verdict
     opposite = {"supported": "not supported", "not supported": "supported"}.get(verdict, verdict)
     assert {k: c.verdict for k, c in claims.items()} == {
@@ -187,7 +212,15 @@ def test_verdict_rules(shift, verdict):
     for c in claims.values():
         assert c.key.reproducible == "statistical" and c.key.null == 0.0 and c.key.unit == "m"
         assert isinstance(c.key.value, float) and c.key.has_ci
-        assert len(c.claim) <= 120 and len(c.paper) <= 150 and len(c.rule) <= 300
+        assert len(c.claim) <= CLAIM_MAX and len(c.paper) <= PAPER_MAX, c.id
+        assert len(c.rule) <= RULE_MAX, c.id
+        assert c.part == "paper" and c.setup == uav_claims.SETUP
+        assert "inside ±0.25 m" in c.rule
+    pairs = {"UAV-1": ("N_T=250", "N_T=50"), "UAV-2": ("N_T=250", "NBO")}
+    pairs["UAV-3"] = ("N_T=250", "tree N=8 M=250")
+    for cid, (a, b) in pairs.items():
+        assert claims[cid].rule == uav_claims.paired_rule(a, b, MARGIN).text()
+        assert claims[cid].key.name == f"mean d, e({a}) − e({b})"
     pd.testing.assert_frame_equal(paired, analysis.paired_differences(runs, seed=1, n_boot=2000))
 
 
@@ -199,30 +232,102 @@ def test_verdict_rules(shift, verdict):
         (-0.3, 0.2, "inconclusive"),  # the CI contains 0
         (0.0, 0.3, "inconclusive"),
         (1e-12, 0.3, "not supported"),
+        (-0.5, 0.5, "inconclusive"),
+        # the equivalence margin m = 0.25: strictly inside ±m is equivalent, touching is not
+        (-0.2499, 0.2499, "equivalent"),
+        (-0.25, 0.1, "inconclusive"),
+        (-0.1, 0.25, "inconclusive"),
+        (-0.25, -0.01, "supported"),  # below 0, touches -m
+        (-0.2499, -0.01, "equivalent"),  # below 0, yet any difference is smaller than m
+        (0.01, 0.25, "not supported"),
+        (0.01, 0.2499, "equivalent"),
+        (0.0, 0.0, "equivalent"),
     ],
 )
 def test_verdict_rule_edges(lo, hi, expected):
     facts = {f"{uav_claims.KEY}_low": lo, f"{uav_claims.KEY}_high": hi}
-    assert uav_claims.paired_rule("A", "B").verdict(facts) == expected
+    assert uav_claims.paired_rule("A", "B", MARGIN).verdict(facts) == expected
     # the same through uav_claims, from a synthetic paired table with exactly this CI
     summary, paired = _analyse(_runs(_centred_noise(20, 0.3)), n_boot=200)
     key = (paired["method"] == "rsmhp_nt250") & (paired["baseline"] == "nbo")
     paired.loc[key, ["ci_low", "ci_high", "mean_diff"]] = [lo, hi, (lo + hi) / 2]
-    uav2 = next(c for c in uav_claims.uav_claims(summary, paired) if c.id == "UAV-2")
+    uav2 = next(c for c in uav_claims.uav_claims(summary, paired, MARGIN) if c.id == "UAV-2")
     assert uav2.verdict == expected
     assert (uav2.key.ci_low, uav2.key.ci_high) == (lo, hi)
 
 
-def _section(runs: pd.DataFrame, n_boot: int = 500):
+def test_paired_rule_text_and_margin():
+    rule = uav_claims.paired_rule("N_T=250", "NBO", 0.25)
+    assert rule.verdicts == ("equivalent", "supported", "not supported", "inconclusive")
+    text = rule.text()
+    assert text.startswith("d_r = e_r(N_T=250) − e_r(NBO)")
+    assert "equivalent if the 95% CI of mean d lies inside ±0.25 m" in text
+    assert text.endswith("inconclusive otherwise")
+    # another margin changes the verdict of the same CI
+    facts = {f"{uav_claims.KEY}_low": -0.2, f"{uav_claims.KEY}_high": -0.1}
+    assert uav_claims.paired_rule("A", "B", 0.25).verdict(facts) == "equivalent"
+    assert uav_claims.paired_rule("A", "B", 0.15).verdict(facts) == "supported"
+    for bad in (0.0, -0.25):
+        with pytest.raises(ValueError, match="margin"):
+            uav_claims.paired_rule("A", "B", bad)
+
+
+def test_contrary_evidence_is_named():
+    # N_T = 100 is worse than N_T = 50 (a trend comparison on the opposite side), while the
+    # key comparison N_T = 250 - N_T = 50 lies below 0
+    diff = -0.5 + _centred_noise(200, 0.3)
+    mid = 1.0 + _centred_noise(200, 0.3, seed=1)
+    runs = _runs(diff, tree=True, mid=mid)
+    summary, paired = _analyse(runs)
+    claims = {c.id: c for c in uav_claims.uav_claims(summary, paired, MARGIN)}
+    assert claims["UAV-1"].verdict == "supported"
+    # e(N_T=100) - e(N_T=50) = 1.0 - (-0.5) = +1.5 per run
+    assert claims["UAV-1"].contrary.startswith("RS-MHP N_T=100 − RS-MHP N_T=50: +1.5")
+    assert "N_T=250 − RS-MHP N_T=100" not in claims["UAV-1"].contrary  # its CI is below 0
+    # UAV-2: every other method vs NBO whose CI lies above 0 (only N_T=100: +1 m)
+    assert claims["UAV-2"].verdict == "supported"
+    assert claims["UAV-2"].contrary.startswith("RS-MHP N_T=100 − NBO: +1.0")
+    assert "pruned tree N=8 M=250 − NBO" not in claims["UAV-2"].contrary  # -1.5 m, below 0
+    assert "RS-MHP N_T=50 − NBO" not in claims["UAV-2"].contrary  # below 0
+    assert "RS-MHP N_T=250 − NBO" not in claims["UAV-2"].contrary  # the key comparison
+    # no contrary evidence when every comparison agrees
+    runs = _runs(-0.5 + _centred_noise(200, 0.3))
+    summary, paired = _analyse(runs)
+    assert all(not c.contrary for c in uav_claims.uav_claims(summary, paired, MARGIN))
+
+
+def test_uav3_names_the_planning_time_when_pruning_was_slower():
+    diff = 0.5 + _centred_noise(200, 0.3)  # the pruned tree has the larger error: supported
+    fast = _runs(diff, tree=True, tree_seconds=0.05)
+    summary, paired = _analyse(fast)
+    c = next(c for c in uav_claims.uav_claims(summary, paired, MARGIN) if c.id == "UAV-3")
+    assert c.verdict == "supported" and not c.contrary
+    assert "compute: pruned tree N=8 M=250 planned in 0.0500 s per closed-loop run" in c.measured
+    assert "(0.500×; timings of this machine)" in c.measured
+    slow = _runs(diff, tree=True, tree_seconds=0.3)
+    summary, paired = _analyse(slow)
+    c = next(c for c in uav_claims.uav_claims(summary, paired, MARGIN) if c.id == "UAV-3")
+    assert c.verdict == "supported" and "compute:" not in c.measured
+    assert c.contrary == (
+        "compute: pruned tree N=8 M=250 planned in 0.300 s per closed-loop run, RS-MHP "
+        "N_T=250 in 0.100 s (3.00×; timings of this machine): the pruned tree did not save "
+        "computation here"
+    )
+
+
+def _section(runs: pd.DataFrame, n_boot: int = 500, margin: float = MARGIN):
     summary, paired = _analyse(runs, n_boot)
     tables = narrative.uav_tables(summary, paired)
-    return narrative.uav_section(summary, paired, tables, DEFAULT_UAV, n_boot, runs), tables
+    section = narrative.uav_section(summary, paired, tables, DEFAULT_UAV, n_boot, runs, margin)
+    return section, tables
 
 
 def _no_bad_numbers(text: str) -> None:
     assert not re.search(r"\b(nan|inf|NaN|Inf|None)\b", text), text
-    # integers are printed as integers (no 100.0 runs, 60.0 steps, Δt = 1.0 s)
-    assert not re.search(r"(?<![\d.])\d+\.0\b(?!\d)", text), re.findall(r"\S*\d+\.0\b\S*", text)
+    # integers are printed as integers (no 100.0 runs, 60.0 steps, Δt = 1.0 s); a percentage
+    # is a measured ratio printed with its significant digits (2.04% prints as 2.0%)
+    bad = re.findall(r"\S*(?<![\d.])\d+\.0\b(?![\d%])\S*", text)
+    assert not bad, bad
 
 
 @pytest.mark.parametrize("zero_diff", [False, True])
@@ -251,13 +356,31 @@ def test_section_budget_and_formatting(tmp_path, zero_diff):
     appendix = render_appendix([section], {}, {})
     for text in (section.body, section.appendix, report, appendix):
         _no_bad_numbers(text)
+    # every CI lies inside ±m (d = 0 exactly, or 0.01 m with a 0.05 m spread): equivalent
+    assert [c.verdict for c in section.claims] == ["equivalent"] * 3
+    assert "m = 0.25 m (fixed in the config before the run)" in section.body
+    assert "3 of 3 CIs lie inside ±m and 0 contain 0" in section.body
+    assert "the differences the paper's figures show do not appear" in section.body
     if zero_diff:
         assert "n/a" in tables["uav_paired"] and "test is undefined" in tables["uav_paired"]
-        assert all(c.verdict == "inconclusive" for c in section.claims)
     # the runs column and the counts are integers
     assert re.search(r"\|\s+200 \|", tables["uav_methods"])
     section.save(tmp_path / "uav.json")
     assert Section.load(tmp_path / "uav.json") == section
+
+
+def test_section_names_the_claims_decided_on_one_side():
+    section, _ = _section(_runs(-0.5 + _centred_noise(200, 0.3), tree=True))
+    assert [c.verdict for c in section.claims] == ["supported", "supported", "not supported"]
+    assert (
+        "CIs on one side of 0: UAV-1 (supported), UAV-2 (supported), UAV-3 (not supported)"
+        in section.body
+    )
+    assert "0 of 3 CIs lie inside ±m" in section.body
+    # a larger margin turns the same data into equivalences
+    section, _ = _section(_runs(-0.5 + _centred_noise(200, 0.3), tree=True), margin=2.0)
+    assert [c.verdict for c in section.claims] == ["equivalent"] * 3
+    assert "m = 2 m" in section.body and "±2 m" in section.claims[0].rule
 
 
 def test_robust_range_and_clip_note():

@@ -63,3 +63,35 @@ def test_bad_definitions_are_refused():
         Rule(cases=(), otherwise="inconclusive")
     with pytest.raises(ValueError, match="claimed must be"):
         ci_side("d", 0.0, claimed="sideways")
+
+
+# --------------------------------------------------------------- equivalence margin
+
+
+@pytest.mark.parametrize(
+    ("low", "high", "verdict"),
+    [
+        (-0.1, 0.1, "equivalent"),  # inside ±0.25: any difference is below the margin
+        (-0.2, -0.05, "equivalent"),  # significant but negligible: still not the effect
+        (-0.25, 0.1, "inconclusive"),  # touches the margin: a difference of m is possible
+        (-0.4, -0.3, "supported"),  # beyond the margin on the claimed side
+        (-0.4, -0.01, "supported"),
+        (0.05, 0.3, "not supported"),
+        (-0.3, 0.3, "inconclusive"),
+    ],
+)
+def test_ci_side_with_a_margin(low, high, verdict):
+    rule = ci_side("d", 0.0, claimed="below", margin=0.25, margin_text="0.25 m")
+    assert rule.verdict({"d_low": low, "d_high": high}) == verdict
+    assert rule.verdicts == ("equivalent", "supported", "not supported", "inconclusive")
+    assert rule.text().startswith("Equivalent if the 95% CI of d lies inside ±0.25 m;")
+
+
+def test_ci_side_margin_around_a_nonzero_null_and_bad_margins():
+    rule = ci_side("f", 1.0, claimed="above", margin=0.1)
+    assert rule.verdict({"f_low": 0.95, "f_high": 1.05}) == "equivalent"
+    assert rule.verdict({"f_low": 1.2, "f_high": 1.3}) == "supported"
+    assert "inside 1 ± 0.1" in rule.text()
+    for bad in (0.0, -1.0, "0.1"):
+        with pytest.raises(ValueError, match="margin"):
+            ci_side("f", 0.0, claimed="above", margin=bad)

@@ -125,8 +125,15 @@ def test_recording_and_report(run_j2, tiny):
     for cid in ("LQG-1", "LQG-2", "LQG-3", "LQG-4"):
         assert f"| {cid} |" in report and f"### {cid} ({by_id[cid]['verdict']})" in appendix
         assert by_id[cid]["key"]["reproducible"] == "bitwise"
+    # the glance table: the paper's statements, then the claims beyond the paper
     glance = (run_j2 / "results/paper/glance.md").read_text()
-    assert [line.split(" | ")[0][2:] for line in glance.splitlines()[2:]] == list(by_id)
+    beyond = [cid for cid, c in by_id.items() if c["part"] == "beyond"]
+    statements = [st["id"] for st in claims["statements"]]
+    assert [line.split(" | ")[0][2:] for line in glance.splitlines()[2:]] == statements + beyond
+    # every claim of the paper is evidence of exactly the statements that list it
+    counted = {cid for st in claims["statements"] for cid in st["counted"] + st["alongside"]}
+    assert {cid for cid, c in by_id.items() if c["part"] == "paper"} <= counted
+    assert all(c["setup"] for c in by_id.values())
     assert "seed: 7" in appendix  # the tiny config's seed, i.e. the parameters actually used
     prov = json.loads((run_j2 / "results/provenance.json").read_text())
     assert {"commit", "config sha256", "blas", "cpu", "host", "date (UTC)"} <= prov.keys()

@@ -26,7 +26,8 @@ Stages of the pipeline (one module per model and stage)
   analysis          lqg, estimators, uav, decisions_lqg, decisions_uav: tables -> statistics
   figures           lqg, estimators, uav, decisions: seaborn figures (PNG + PDF)
   recording         rerun recordings of sampled trajectory trees
-  claims            per study: the claims (key number + verdict rule) from the statistics
+  claims            per study: the claims (key number + verdict rule) from the statistics;
+                    claims.paper: the paper's statements, each with its evidence and verdict
   narrative         per study: the report section's prose, tables and appendix (Markdown)
   ledger            the claims data model: KeyNumber, Claim, Section
   verdicts          verdict rules as objects (Rule, Case, at_most, ci_side): text + evaluation
@@ -35,6 +36,8 @@ Stages of the pipeline (one module per model and stage)
   report            renders the main text, appendix, claims and glance table from the sections
   readme            splices the glance table into README.md (``make publish``)
   verify            a run's claims against the committed reference (``make verify``)
+  portability       the portability drill: a run on an emulated other machine against the
+                    native run and the reference (``make portability``)
   palette           one colour and label per method, for every figure and recording
 Workflow support
   config            config files and schema checks (``python -m rsmhp.config FILE``)

@@ -11,12 +11,12 @@ provenance in :mod:`rsmhp.provenance`, the README block in :mod:`rsmhp.readme`.
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Mapping
+from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
 import yaml
 
-from rsmhp.claims.paper import GENERAL_RULE, HEDGED_RULE, Judgement, judge_all
+from rsmhp.claims.paper import GENERAL_RULE, HEDGED_RULE, Judgement, Statement, judge_all
 from rsmhp.ledger import STATEMENT_VERDICTS, VERDICTS, Claim, Section
 from rsmhp.markdown import escape, fmt, fmt_ci
 
@@ -42,17 +42,17 @@ def _ledger_number(c: Claim) -> str:
 
 
 def claims_table(claims: Iterable[Claim]) -> str:
-    """The claims: id, claim (with its scope), the setup it was tested on, the paper's
-    statement, our key number with its 95% CI, verdict, the rule that gave it, and the
-    contrary evidence (cells or settings whose CI lies on the opposite side)."""
+    """The claims: id, claim (with its scope), the setup it was tested on, our key number
+    with its 95% CI, verdict, the rule that gave it, and the contrary evidence (cells or
+    settings whose CI lies on the opposite side). What the paper says is in the statements
+    table (part 1) and in each claim's details (appendix)."""
     lines = [
-        "| id | claim | setup | paper | our number (95% CI) | verdict | verdict rule "
-        "| contrary evidence |",
-        "|---|---|---|---|---|---|---|---|",
+        "| id | claim | setup | our number (95% CI) | verdict | verdict rule | contrary evidence |",
+        "|---|---|---|---|---|---|---|",
     ]
     for c in claims:
         lines.append(
-            f"| {c.id} | {escape(c.claim)} | {escape(c.setup)} | {escape(c.paper)} "
+            f"| {c.id} | {escape(c.claim)} | {escape(c.setup)} "
             f"| {escape(_ledger_number(c))} | **{c.verdict}** | {escape(c.rule)} "
             f"| {escape(c.contrary) if c.contrary else '–'} |"
         )
@@ -98,11 +98,12 @@ def statements_records(judgements: Iterable[Judgement]) -> list[dict[str, Any]]:
     ]
 
 
-def glance_table(claims: Iterable[Claim]) -> str:
-    """The README's "results at a glance": the paper's statements with their verdicts, then
-    the claims beyond the paper (id, claim, key number with CI, verdict)."""
+def glance_table(claims: Iterable[Claim], statements: Sequence[Statement] | None = None) -> str:
+    """The README's "results at a glance": the paper's statements (default
+    :data:`rsmhp.claims.paper.STATEMENTS`) with their verdicts, then the claims beyond the
+    paper (id, claim, key number with CI, verdict)."""
     claims = list(claims)
-    judgements, _ = judge_all(claims)
+    judgements, _ = judge_all(claims, statements)
     lines = ["| | claim | our number (95% CI) | verdict |", "|---|---|---|---|"]
     for j in judgements:
         nums = "; ".join(f"{c.id}: {_ledger_number(c)}" for c in j.counted)
@@ -161,9 +162,9 @@ def _counts(verdicts: Iterable[str], vocabulary: tuple[str, ...]) -> str:
     )
 
 
-def _ledger(claims: list[Claim]) -> list[str]:
+def _ledger(claims: list[Claim], statements: Sequence[Statement] | None) -> list[str]:
     """The two parts of the claims ledger (main text)."""
-    judgements, untested = judge_all(claims)
+    judgements, untested = judge_all(claims, statements)
     paper = [c for c in claims if c.part == "paper"]
     beyond = [c for c in claims if c.part == "beyond"]
     n_bit = sum(c.key.reproducible == "bitwise" for c in claims)
@@ -184,9 +185,8 @@ def _ledger(claims: list[Claim]) -> list[str]:
         f"{len(judgements)} statements of the paper, each tested on the paper's own setups "
         f"({len(paper)} claims of evidence): "
         + _counts((j.verdict for j in judgements), STATEMENT_VERDICTS)
-        + f". A general statement's verdict combines its evidence {GENERAL_RULE.text()}. A "
-        f"hedged one ('may'): {HEDGED_RULE.text()}; the table names where it was and was not "
-        "shown."
+        + f". A general statement's verdict, {GENERAL_RULE.text()}. A hedged one ('may'): "
+        f"{HEDGED_RULE.text()}; the table names where it was and was not shown."
         + (f" Not tested in this run: {', '.join(untested)}." if untested else ""),
         "",
         statements_table(judgements),
@@ -209,7 +209,10 @@ def _ledger(claims: list[Claim]) -> list[str]:
 
 
 def render_report(
-    sections: Iterable[Section], provenance: Mapping[str, str], appendix: str = "appendix.md"
+    sections: Iterable[Section],
+    provenance: Mapping[str, str],
+    appendix: str = "appendix.md",
+    statements: Sequence[Statement] | None = None,
 ) -> str:
     """The main text: introduction, claims ledger, one section per study (in ``order``), a
     short provenance note; details go to :func:`render_appendix` (file ``appendix``)."""
@@ -223,7 +226,7 @@ def render_report(
         "2021. Written by the pipeline (`snakemake report`) from `results/` of one run; tables, "
         f"claim details, parameters and provenance are in [{appendix}]({appendix}).",
         "",
-        *_ledger(all_claims),
+        *_ledger(all_claims, statements),
     ]
     for s in sections:
         parts += [f"## {s.title}", "", s.body.strip(), ""]

@@ -122,7 +122,8 @@ class ExceedanceTest:
     exact one; ``above_bound``: cells whose Clopper-Pearson lower limit (familywise level)
     lies above the bound, i.e. the bound fails; ``exact_above_bound``: cells whose exact
     probability exceeds the bound (a bound that is not one); ``min_p``: the smallest
-    Bonferroni-adjusted p-value (capped at 1) and ``worst`` its cell's index;
+    Bonferroni-adjusted p-value (capped at 1) and ``worst`` the index of the cell with the
+    smallest raw p-value;
     ``max_exact_ratio``: the largest exact / bound over cells with a bound below 1."""
 
     cells: int
@@ -168,7 +169,7 @@ def exceedance_test(
         above_bound=int(np.sum(low > bound)),
         exact_above_bound=int(np.sum(exact > bound * (1 + 1e-9))),
         min_p=float(adjusted.min()),
-        worst=int(np.argmin(adjusted)),
+        worst=int(np.argmin(p)),
         max_exact_ratio=float(ratio.max()) if ratio.size else float("nan"),
     )
 

@@ -345,9 +345,8 @@ def _dec5(summary: pd.DataFrame, z: ZCheck) -> Claim | None:
     rule = RULES["DEC-5"]
     return Claim(
         "DEC-5",
-        "In the oven LQG with open-loop controls (where the weighting's bias J(Σ/2) − J = "
-        "−r v_H/2 does not depend on u, so it cannot move the chosen controls), likeliness-"
-        "weighted Monte Carlo's mean regret follows κ v_H (4/3)^{H/2}/(3P)",
+        "In the oven LQG with open-loop controls (where the weighting's bias −r v_H/2 does not "
+        "depend on u), likeliness-weighted Monte Carlo's mean regret is κ v_H (4/3)^{H/2}/(3P)",
         "Not in the paper (Sec. II ranks trajectories by likeliness to prune); "
         "first-order closed form derived here",
         KeyNumber(

@@ -37,6 +37,7 @@ from rsmhp.analysis.uav import baseline_name, is_family
 from rsmhp.ledger import Claim, KeyNumber
 from rsmhp.markdown import fmt, fmt_ci, param_text, range_text
 from rsmhp.palette import method_label
+from rsmhp.uav import methods as registry
 from rsmhp.uav.methods.monte_carlo import MonteCarlo
 from rsmhp.verdicts import Case, Facts, Rule, ci_side
 
@@ -80,8 +81,8 @@ def regret_rule(margin_pp: float, setting: str) -> Rule:
 
 
 DEC8_RULE = Rule(
-    basis="d = closed-loop average location error of the RS-MHP member of the map fixed in "
-    "the config (decisions.claims.map_method) − NBO, "
+    basis="d = closed-loop average location error of the map method fixed in the config "
+    "(decisions.claims.map_method) − NBO, "
     "paired over runs; 95% bootstrap CIs",
     cases=(
         Case(
@@ -231,8 +232,8 @@ def map_comparison(map_df: pd.DataFrame, method: str = "") -> tuple[str, list[st
     if method:
         if method not in methods:
             raise ValueError(
-                f"decisions.claims.map_method = {method!r} is not a method of the map "
-                f"(allowed: {', '.join(methods)})"
+                f"decisions.claims.map_method = {method!r} is not a compared method of the "
+                f"map (allowed: {', '.join(methods)})"
             )
         chosen = comps[methods.index(method)]
     elif rs:
@@ -242,10 +243,13 @@ def map_comparison(map_df: pd.DataFrame, method: str = "") -> tuple[str, list[st
     return chosen, [m for c, m in zip(comps, methods, strict=True) if c != chosen]
 
 
-def map_contrary(map_df: pd.DataFrame, limited: pd.Series, flag: bool) -> str:
-    """Every (cell, comparison) of the group (``limited == flag``) whose 95% CI of RS-MHP −
-    NBO lies above 0 (RS-MHP significantly worse), for every method of the map."""
-    rows = map_df[(limited == flag) & (map_df["ci_low"] > 0)]
+def map_contrary(map_df: pd.DataFrame, limited: pd.Series, flag: bool, method: str) -> str:
+    """Every (cell, comparison) of the group (``limited == flag``) whose 95% CI of method −
+    NBO lies above 0 (significantly worse than NBO), for every method of the map of the same
+    family as ``method`` (the compared one: e.g. every RS-MHP N_T)."""
+    methods = pd.Series([c.split(" − ")[0] for c in map_df["comparison"]], index=map_df.index)
+    family = type(registry.from_name(method))
+    rows = map_df[(limited == flag) & (map_df["ci_low"] > 0) & is_family(methods, family)]
     return "; ".join(
         f"{_cell_name(r)}: {method_label(r['comparison'].split(' − ')[0])} − NBO = "
         f"{fmt(r['mean_diff'], 3, True)} {fmt_ci(r['ci_low'], r['ci_high'], 3, True)} m"
@@ -300,7 +304,8 @@ def _dec8_claim(
         f"{regret_txt} (means over the cells); the compared method, {method_label(method)}, "
         "is fixed in the config before the run (decisions.claims.map_method)",
         dropped=(
-            f"the map's other comparisons ({others} − {baseline_name()}) are not the key "
+            f"the map's other comparisons ({others} − {method_label(baseline_name())}) are not "
+            "the key "
             "number; cells where one of them lies on the opposite side are named as contrary"
             if others
             else ""
@@ -328,7 +333,7 @@ def _dec8(
         sel = groups[(groups["comparison"] == comp) & (groups["limited"] == flag)]
         if not sel.empty:
             others = ", ".join(method_label(m) for m in other_methods)
-            contrary = map_contrary(map_df, limited, flag)
+            contrary = map_contrary(map_df, limited, flag, comp.split(" − ")[0])
             claims.append(_dec8_claim(cid, label, sel.iloc[0], map_df, others, contrary))
     return claims
 
@@ -346,6 +351,9 @@ def uav_claims(
     """Claims DEC-6, DEC-7-<model>, DEC-8a/b (module doc); ``groups`` is
     :func:`rsmhp.analysis.decisions_uav.summarize_map_groups`, ``rules`` the
     ``decisions.claims`` config (equivalence margin, the map method of DEC-8)."""
+    missing = [k for k in ("equivalence_margin_pp", "map_method") if k not in rules]
+    if missing:
+        raise ValueError(f"decisions.claims lacks {missing} (the config schema fills defaults)")
     margin = float(rules["equivalence_margin_pp"])
     claims: list[Claim] = []
     models: Sequence[str] = list(dict.fromkeys(regret["model"]))

@@ -165,8 +165,8 @@ def rule_est3(ks: Sequence[float]) -> Rule:
     base = exceedance_rule("")
     return Rule(
         basis=f"Plain MC, ε = k·sd_n, k in {{{', '.join(k_text(k) for k in ks)}}}: per "
-        "(problem, n, k) cell the exceedance count against its exact probability and "
-        "against Chebyshev's bound 1/k²; the Var-vs-n log-log slope per problem",
+        "(problem, n, k) cell the exceedance count vs its exact probability and vs 1/k² "
+        "(Chebyshev); Var-vs-n log-log slope per problem",
         cases=(
             Case(
                 "not supported",
@@ -243,8 +243,19 @@ def facts_est3(cheb: pd.DataFrame, s: pd.DataFrame) -> dict[str, float]:
     of :func:`rsmhp.claims.lqg.exceedance_facts`, MC variance slopes and those whose CI
     excludes -1."""
     rate = mc_variance_slopes(s)
+    empty = {
+        "cells": 0,
+        "departing": 0,
+        "above bound": 0,
+        "exact above bound": 0,
+        "detectable": np.inf,
+    }
     return {
-        **exceedance_facts(_exceedance(cheb)),
+        **(
+            exceedance_facts(_exceedance(cheb), float(cheb["detectable"].min()))
+            if len(cheb)
+            else empty
+        ),
         "slopes": len(rate),
         "slopes_off": sum(not f.contains(-1.0) for f in rate.values()),
     }
@@ -450,11 +461,16 @@ def claim_est3(s: pd.DataFrame, cheb: pd.DataFrame) -> Claim:
                 f"the most sensitive cell detects a spread error of {fmt(100 * det, 2)}% "
                 "with 80% power"
                 if np.isfinite(det)
-                else "no cell detects a spread error below 50% with 80% power (too few "
-                "replicates)"
+                else "no cell detects a spread error below 50% with 80% power (too few replicates)"
             )
-            + "; variance slope vs n: "
-            + ", ".join(f"{p} {fmt(f.slope, 3)} {fmt_ci(f.low, f.high)}" for p, f in rate.items())
+            + (
+                "; variance slope vs n: "
+                + ", ".join(
+                    f"{p} {fmt(f.slope, 3)} {fmt_ci(f.low, f.high)}" for p, f in rate.items()
+                )
+                if rate
+                else "; no variance slope (fewer than 3 budgets)"
+            )
         )
     return Claim(
         id="EST-3",
@@ -520,9 +536,9 @@ def _measured_est4(top: pd.DataFrame) -> str:
         for p, g in top.groupby("problem", sort=False)
     )
     if len(top):
-        near = top.loc[top["bias_fraction_high"].idxmin()]
+        near = top.loc[top["bias_fraction_low"].idxmin()]
         summary += (
-            f"; closest to J: {near['problem']} M = {int(near['M'])}, "
+            f"; CI reaching nearest to J: {near['problem']} M = {int(near['M'])}, "
             f"{fmt(near['bias_fraction_of_nbo'], 3)} "
             f"{fmt_ci(near['bias_fraction_low'], near['bias_fraction_high'])}"
         )

@@ -243,9 +243,16 @@ def fig3_claim(summary: pd.DataFrame) -> Claim:
 # ------------------------------------------------------------------------------- LQG-3
 
 
+#: LQG-3/EST-3 are a test only if some cell would detect a spread of the estimator's error
+#: this far (relative) from the exact one with 80% power
+POWER_LIMIT = 0.5
+
+
 def exceedance_rule(basis: str) -> Rule:
-    """The rule of Prop. 3's evidence (LQG-3, EST-3, LIN-1): exceedance counts against the
-    exact tail probability (power) and against Chebyshev's bound (the statement)."""
+    """The rule of Prop. 3's evidence (LQG-3, EST-3): exceedance counts against the exact tail
+    probability (power) and against Chebyshev's bound (the statement); ``supported`` needs a
+    test with power (some cell detects a spread error of :data:`POWER_LIMIT` with 80%
+    power)."""
     return Rule(
         basis=basis,
         cases=(
@@ -258,22 +265,31 @@ def exceedance_rule(basis: str) -> Rule:
             Case(
                 "supported",
                 "no cell's count departs from the exact probability (two-sided exact binomial "
-                "tests, familywise 95%) and the exact probability is below the bound in every "
-                "cell",
-                lambda f: f["cells"] >= 1 and f["departing"] == 0 and f["exact above bound"] == 0,
+                "tests, familywise 95%), the exact probability is below the bound in every "
+                f"cell, and some cell would detect a spread error of {100 * POWER_LIMIT:g}% "
+                "with 80% power",
+                lambda f: (
+                    f["cells"] >= 1
+                    and f["departing"] == 0
+                    and f["exact above bound"] == 0
+                    and f["detectable"] <= POWER_LIMIT
+                ),
             ),
         ),
         otherwise="inconclusive",
     )
 
 
-def exceedance_facts(test: ExceedanceTest) -> Facts:
-    """The facts of :func:`exceedance_rule` from :func:`rsmhp.stats.exceedance_test`."""
+def exceedance_facts(test: ExceedanceTest, detectable: float = np.inf) -> Facts:
+    """The facts of :func:`exceedance_rule` from :func:`rsmhp.stats.exceedance_test` and the
+    smallest detectable relative spread error over the cells
+    (:func:`rsmhp.stats.detectable_scale`; ``inf``: no power)."""
     return {
         "cells": test.cells,
         "departing": test.departing,
         "above bound": test.above_bound,
         "exact above bound": test.exact_above_bound,
+        "detectable": float(detectable),
     }
 
 
@@ -286,7 +302,7 @@ CHEBYSHEV_RULE = exceedance_rule(
 
 def chebyshev_facts(check: ChebyshevCheck) -> Facts:
     """The numbers :data:`CHEBYSHEV_RULE` is evaluated on."""
-    return exceedance_facts(check.test)
+    return exceedance_facts(check.test, check.detectable)
 
 
 def _chebyshev_measured(check: ChebyshevCheck, eps_values: Sequence[float]) -> str:

@@ -146,13 +146,16 @@ def judge(statement: Statement, claims: Iterable[Claim]) -> Judgement | None:
     )
 
 
-def judge_all(claims: Iterable[Claim]) -> tuple[list[Judgement], list[str]]:
-    """Every statement with evidence in this run, in the paper's order, and the ids of the
-    statements without any (not tested in this run). Refuses a claim of part ``paper`` that
-    no statement lists (it would be counted nowhere)."""
+def judge_all(
+    claims: Iterable[Claim], statements: Sequence[Statement] | None = None
+) -> tuple[list[Judgement], list[str]]:
+    """Every statement (default :data:`STATEMENTS`) with evidence in this run, in order, and
+    the ids of the statements without any (not tested in this run). Refuses a claim of part
+    ``paper`` that no statement lists (it would be counted nowhere)."""
     claims = list(claims)
+    statements = STATEMENTS if statements is None else tuple(statements)
     orphans = [
-        c.id for c in claims if c.part == "paper" and not any(s.matches(c.id) for s in STATEMENTS)
+        c.id for c in claims if c.part == "paper" and not any(s.matches(c.id) for s in statements)
     ]
     if orphans:
         raise ValueError(
@@ -160,7 +163,7 @@ def judge_all(claims: Iterable[Claim]) -> tuple[list[Judgement], list[str]]:
             "rsmhp.claims.paper.STATEMENTS lists them as evidence"
         )
     out, untested = [], []
-    for s in STATEMENTS:
+    for s in statements:
         j = judge(s, claims)
         if j is None:
             untested.append(s.id)
@@ -177,9 +180,10 @@ _PROP1_GAP = (
     "leaves share the draw of level k whenever their level-k indices agree, however far apart "
     "they are: leaf (1, 1, …, 1) and leaf (2, 1, …, 1) lie N^{H−1} positions apart and share "
     "H − 1 of their H draws. With g = c + bᵀw + wᵀKw (the LQG's cost as a quadratic form of "
-    "the noise), two leaves sharing the set S of levels have Cov = Var(E[g | w_S]) > 0, and "
-    "averaging over all pairs gives Var(J_tree) = bᵀSb/N + 2 tr((KS)²)/N² + 2(N−1)/N² "
-    "Σ_k tr((K_kk Σ)²) (appendix), which decays like 1/N, not like 1/N^H. The conclusion "
+    "the stacked noise w ~ N(0, S), S = I_H ⊗ Σ, c = J_NBO), two leaves sharing the draws of "
+    "the set L of levels have Cov = Var(E[g | w_L]) > 0, and averaging over all pairs gives "
+    "Var(J_tree) = bᵀSb/N + 2 tr((KS)²)/N² + 2(N−1)/N² Σ_k tr((K_kk Σ)²) (estimator study, "
+    "appendix), which decays like 1/N, not like 1/N^H. The conclusion "
     "(convergence in probability) still holds because this variance tends to 0, but the "
     "covariances do not vanish with |i − j|, so the cited condition is not met; the "
     "estimator study (EST-1) measures the 1/N rate."

@@ -221,7 +221,7 @@ def _uav3(summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str], marg
     main, is_key = _pick(paired, ab)
     others = paired[(paired["purpose"] == PRUNING) & ~is_key]
     compute, slower = _compute(summary, main["baseline"], main["method"])
-    contrary = [_opposite(paired[(paired["purpose"] == PRUNING)])]
+    contrary = [_opposite(paired[(paired["purpose"] == PRUNING) & ~is_key])]
     if slower:
         contrary.append(f"{compute}: the pruned tree did not save computation here")
     measured = _stats(main) + (f"; {compute}" if compute and not slower else "")

@@ -107,19 +107,23 @@ def _findings(claims: Sequence[Claim], summary: pd.DataFrame, scaling: pd.DataFr
         out.append("Simulated vs closed-form mean regret: max |z| " + ", ".join(parts) + ".")
     fits = [
         f"{range_text(s['slope'], signed=True)} for {what}"
-        for method, what in (
-            ("mc", "Monte Carlo"),
-            ("sobol", "scrambled Sobol' points"),
-            ("pruned", "the pruned tree (in M)"),
-        )
+        for method, what in (("mc", "Monte Carlo"), ("sobol", "scrambled Sobol' points"))
         if not (s := slopes(scaling, method)).empty
     ]
     if fits:
+        out.append("Log-log slopes of mean regret in P: " + ", ".join(fits) + ".")
+    if "DEC-4" in c:
+        d4 = c["DEC-4"]
+        shape = (
+            "rises again after its minimum over M in some cells (a U shape), so no slope "
+            "summarises it"
+            if d4.contrary
+            else "is summarised by its shape in M"
+        )
         out.append(
-            "Log-log slopes of mean regret: "
-            + ", ".join(fits)
-            + (f" (DEC-4 {c['DEC-4'].verdict})" if "DEC-4" in c else "")
-            + "."
+            f"The pruned tree's regret {shape}: {d4.key.name} = {fmt(d4.key.value, 3)} "
+            f"(DEC-4 {d4.verdict}; the regret at the smallest, the best and the largest M of "
+            "every cell is in its details)."
         )
     return " ".join(out)
 

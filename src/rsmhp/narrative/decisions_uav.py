@@ -131,8 +131,34 @@ def _dec7_text(cid: str, c: Claim, summary: pd.DataFrame) -> str:
     )
 
 
+def _margin_text(margin: float, regret: pd.DataFrame, base: str | None, claims) -> str:
+    """Why the equivalence margin of DEC-6/DEC-7 is what it is (numbers of this run)."""
+    out = (
+        f"The equivalence margin m = {param_text(margin)} pp (fixed in the config before the "
+        "run, decisions.claims.equivalence_margin_pp)"
+    )
+    if base is not None and (regret["model"] == base).any():
+        share = pp(optimiser_share(regret, str(base)))
+        out += f" is {fmt(share / margin, 2)}× smaller than the {fmt(share)}% every method loses "
+        out += "to the common optimiser budget"
+    effects = [
+        c.key.ci_low for c in claims if c.verdict == "supported" and c.id.startswith("DEC-7-")
+    ]
+    if effects:
+        out += (
+            f", and below the lower CI limit of every variant called better "
+            f"({fmt(min(effects), 2)} pp): equivalence and 'better' are never said of effects "
+            "of one size"
+        )
+    return out + "."
+
+
 def _findings(
-    claims: Sequence[Claim], regret: pd.DataFrame, summary: pd.DataFrame, base: str | None
+    claims: Sequence[Claim],
+    regret: pd.DataFrame,
+    summary: pd.DataFrame,
+    base: str | None,
+    margin: float,
 ) -> str:
     """One short paragraph of results, every number from the claims and the summary."""
     c = {cl.id: cl for cl in claims}
@@ -148,7 +174,10 @@ def _findings(
                 "averages "
                 f"{fmt(k.value, 3, True)} m {fmt_ci(k.ci_low, k.ci_high, 3, True)} "
                 f"({cid} {c[cid].verdict})."
+                + (f" Contrary: {c[cid].contrary}." if c[cid].contrary else "")
             )
+    if any(cid == "DEC-6" or cid.startswith("DEC-7-") for cid in c):
+        out.append(_margin_text(margin, regret, base, claims))
     return " ".join(out)
 
 
@@ -268,7 +297,9 @@ def uav_decision_section(
     n_boot = int(cfg["map"]["bootstrap"])
     claims = uav_claims(regret, summary, map_df, groups, cfg["claims"], seed, n_boot, base_limited)
     base = base_model(list(dict.fromkeys(regret["model"])))
-    findings = _findings(claims, regret, summary, base)
+    findings = _findings(
+        claims, regret, summary, base, float(cfg["claims"]["equivalence_margin_pp"])
+    )
     body = "\n".join([*_setting(cfg), "", findings, "", *_FIGURE_TEXT])
     return Section(
         key="decisions_uav",
