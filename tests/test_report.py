@@ -321,3 +321,23 @@ def test_every_snakemake_report_caption_is_valid_restructuredtext():
             settings_overrides={"warning_stream": err, "report_level": 2},
         )
         assert not err.getvalue(), f"{path.name}: {err.getvalue()}"
+
+
+def test_verify_fails_when_a_statement_of_the_paper_changes_its_verdict(tmp_path):
+    claims = [_claim("A-1", "supported", -0.3, -0.5, -0.1, "bitwise")]
+    stmt = {"id": "S1", "verdict": "supported"}
+
+    def write(name, statements):
+        data = {"config sha256": "c", "claims": [asdict(c) for c in claims]}
+        if statements is not None:
+            data["statements"] = statements
+        (tmp_path / name).write_text(json.dumps(data))
+        return tmp_path / name
+
+    ref = write("ref.json", [stmt])
+    assert vfy.verify(ref, write("same.json", [stmt]))[0]
+    ok, text = vfy.verify(ref, write("flip.json", [{**stmt, "verdict": "mixed"}]))
+    assert not ok and text.startswith("# verify: FAIL") and "S1: supported -> mixed" in text
+    ok, text = vfy.verify(ref, write("more.json", [stmt, {"id": "S2", "verdict": "mixed"}]))
+    assert not ok and "S2: - -> mixed" in text
+    assert vfy.verify(write("old.json", None), write("new.json", [stmt]))[0]  # old reference

@@ -360,7 +360,7 @@ def test_section_budget_and_formatting(tmp_path, zero_diff):
     assert [c.verdict for c in section.claims] == ["equivalent"] * 3
     assert "m = 0.25 m (fixed in the config before the run)" in section.body
     assert "3 of 3 CIs lie inside ±m and 0 contain 0" in section.body
-    assert "the differences the paper's figures show do not appear" in section.body
+    assert "the difference of Fig. 4 (UAV-1) and Fig. 5 (UAV-2) does not appear" in section.body
     if zero_diff:
         assert "n/a" in tables["uav_paired"] and "test is undefined" in tables["uav_paired"]
     # the runs column and the counts are integers

@@ -14,7 +14,8 @@ this module compares the reference and this run:
   :math:`z = \Phi^{-1}(1 - 0.05 / (2m))` Bonferroni-corrected over the ``m`` statistical
   claims: two independent runs of the same pipeline fall outside with probability <= 5%
   in all (a run on another machine shares the seeds, so it is closer than independent).
-* the **verdict** must be the same.
+* the **verdict** must be the same, and so must the verdict of every statement of the paper
+  (``statements`` of ``claims.json``, when both files have them).
 
 The check fails (exit status 1) when a verdict flips, a number lies outside its tolerance,
 a claim is missing or new, or a claim's key number was redefined (different name or unit:
@@ -38,7 +39,16 @@ from scipy.stats import norm
 from rsmhp.ledger import Claim
 from rsmhp.markdown import fmt, markdown_table
 
-__all__ = ["VerificationError", "compare", "load_claims", "main", "render", "tolerance"]
+__all__ = [
+    "VerificationError",
+    "compare",
+    "load_claims",
+    "load_statements",
+    "main",
+    "render",
+    "statement_flips",
+    "tolerance",
+]
 
 #: relative floating-point tolerance of bitwise-reproducible key numbers
 BITWISE_RTOL = 1e-9
@@ -152,7 +162,34 @@ def verify(reference: str | os.PathLike, run: str | os.PathLike) -> tuple[bool, 
             "without overrides for paper/claims.json)"
         )
     table = compare(ref_claims, run_claims)
-    return bool((table["status"] == "ok").all()), render(table, str(reference), str(run))
+    ok = bool((table["status"] == "ok").all())
+    text = render(table, str(reference), str(run))
+    flips = statement_flips(load_statements(reference), load_statements(run))
+    if flips:
+        ok = False
+        text = text.replace("# verify: PASS", "# verify: FAIL", 1)
+        text += "\nStatements of the paper whose verdict differs: " + "; ".join(flips) + "\n"
+    return ok, text
+
+
+def load_statements(path: str | os.PathLike) -> dict[str, str]:
+    """Statement id -> verdict of a ``claims.json`` (empty for a file without statements,
+    e.g. a reference written before the ledger had them)."""
+    data = json.loads(Path(path).read_text(encoding="utf-8"))
+    return {str(s["id"]): str(s["verdict"]) for s in data.get("statements", [])}
+
+
+def statement_flips(reference: dict[str, str], run: dict[str, str]) -> list[str]:
+    """``S5: mixed -> supported`` for every statement both files judge differently, and
+    statements present in only one of them (when both have statements)."""
+    if not reference or not run:
+        return []
+    out = []
+    for sid in [*reference, *(k for k in run if k not in reference)]:
+        a, b = reference.get(sid, "-"), run.get(sid, "-")
+        if a != b:
+            out.append(f"{sid}: {a} -> {b}")
+    return out
 
 
 def main(argv: Sequence[str] | None = None) -> int:

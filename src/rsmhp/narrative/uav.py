@@ -139,18 +139,25 @@ def _findings(claims: Sequence[Claim], summary: pd.DataFrame, margin: float) -> 
     margin_text = (
         f"The equivalence margin m = {param_text(margin)} m (fixed in the config before the "
         f"run) is {fmt(100 * margin / mean_e, 2)}% of the mean error and "
-        f"{fmt(margin / sd_e, 2)} of its run-to-run SD: a difference smaller than m would not "
-        "separate the CDFs of Figs. 4/5 visibly. "
+        f"{fmt(margin / sd_e, 2)} of its run-to-run SD; a difference below m is treated as "
+        "none. "
     )
     decided = [f"{c.id} ({c.verdict})" for c in claims if c.verdict in VERDICTS[:2]]
+    figures = {"UAV-1": "Fig. 4", "UAV-2": "Fig. 5"}
+    absent = [
+        f"{figures[c.id]} ({c.id})" for c in claims if c.verdict == "equivalent" and c.id in figures
+    ]
+    n_inc = counts["inconclusive"]
     why = (
-        f"{counts['equivalent']} of {len(claims)} CIs lie inside ±m and "
-        f"{counts['inconclusive']} contain 0 without fitting inside it ({n_runs} paired runs, "
-        f"CI half-width about {fmt(half, 2)} m, {fmt(pct, 2)}% of mean e)"
+        f"{counts['equivalent']} of {len(claims)} CIs lie inside ±m and {n_inc} "
+        f"{'contains' if n_inc == 1 else 'contain'} 0 without fitting inside it ({n_runs} "
+        f"paired runs, CI half-width about {fmt(half, 2)} m, {fmt(pct, 2)}% of mean e)"
+        + (f"; CIs on one side of 0: {', '.join(decided)}" if decided else "")
         + (
-            f"; CIs on one side of 0: {', '.join(decided)}. "
-            if decided
-            else ": on this reconstruction the differences the paper's figures show do not appear. "
+            f": on this reconstruction the difference of {' and '.join(absent)} does not "
+            "appear at that resolution. "
+            if absent
+            else ". "
         )
     )
     return (
