@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from scipy import stats
 
 from rsmhp import lqg
@@ -292,3 +294,19 @@ def test_batched_tree_arguments_are_checked(rng):
         sample_tree_batch(prob, prob.x0, prob.u, 2, [rng], max_keep=0)
     with pytest.raises(ValueError, match="at least one generator"):
         sample_tree_batch(prob, prob.x0, prob.u, 2, [])
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(st.integers(-5, 5), min_size=1, max_size=60),  # small integers: many ties
+    st.integers(1, 70),
+    st.booleans(),
+)
+def test_top_m_selects_exactly_what_the_stable_full_sort_selects(values, m, with_nan):
+    """top_m takes a partition shortcut; the oracle is the stable argsort it replaced, ties
+    by index, NaN (never produced by a likeliness, but defined) last."""
+    x = np.asarray(values, dtype=float) / 3.0
+    if with_nan:
+        x[len(x) // 2] = np.nan
+    expected = np.argsort(-x, kind="stable")[:m]
+    np.testing.assert_array_equal(top_m(x, m), expected)

@@ -213,8 +213,14 @@ def top_m(log_likeliness: np.ndarray, m: int) -> np.ndarray:
     Returns all indices (in that order) when ``m >= len(log_likeliness)``.
     """
     m = guards.positive_int("M", m)
-    order = np.argsort(-np.asarray(log_likeliness), kind="stable")
-    return order[:m]
+    neg = -np.asarray(log_likeliness, dtype=float)
+    if m >= neg.size or np.isnan(neg).any():
+        return np.argsort(neg, kind="stable")[:m]
+    # the same indices as the stable full sort, in O(n): every entry up to the m-th smallest
+    # value (ties at the boundary included, in index order), then a stable sort of those
+    kth = np.partition(neg, m - 1)[m - 1]
+    cand = np.flatnonzero(neg <= kth)
+    return cand[np.argsort(neg[cand], kind="stable")][:m]
 
 
 def _propagate(
