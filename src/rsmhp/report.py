@@ -107,9 +107,14 @@ def glance_table(claims: Iterable[Claim], statements: Sequence[Statement] | None
     lines = ["| | claim | our number (95% CI) | verdict |", "|---|---|---|---|"]
     for j in judgements:
         nums = "; ".join(f"{c.id}: {_ledger_number(c)}" for c in j.counted)
+        pieces = (
+            " (" + ", ".join(f"{c.id} {c.verdict}" for c in j.counted) + ")"
+            if len(j.counted) > 1
+            else ""
+        )
         lines.append(
             f"| {j.statement.id} | paper ({j.statement.where}): {escape(j.statement.says)} "
-            f"| {escape(nums)} | {j.verdict} |"
+            f"| {escape(nums)} | {j.verdict}{pieces} |"
         )
     for c in claims:
         if c.part == "beyond":
