@@ -542,8 +542,10 @@ def test_section_budget_numbers_and_roundtrip(small, tmp_path):
     for c in section.claims:
         assert len(c.claim) <= CLAIM_MAX and len(c.paper) <= PAPER_MAX, c.id
         assert len(c.rule) <= RULE_MAX, c.id
-        assert c.part == "paper" and not c.contrary
-    assert {c.setup for c in section.claims[:4]} == {claims.SETUP}
+        # LQG-3 applies Chebyshev to the oven's quadratic cost, outside Prop. 3's linear premise
+        assert c.part == ("beyond" if c.id == "LQG-3" else "paper") and not c.contrary
+    assert {c.setup for c in section.claims[:4] if c.id != "LQG-3"} == {claims.SETUP}
+    assert "outside Prop. 3's linear premise" in section.claims[2].setup
     assert section.claims[-1].setup.startswith("linear-cost")
     # LIN-1 in the body, with its key number and verdict
     lin = section.claims[-1]

@@ -157,7 +157,7 @@ def test_section_roundtrip_and_rendering(tmp_path):
     assert main.index("## Earlier study") < main.index("## Later study")
     assert main.index("## Claims ledger") < main.index("## Earlier study")
     # part 1: each statement once with its verdict from its evidence; part 2 apart
-    assert "2 statements of the paper" in main and "(2 claims of evidence)" in main
+    assert "2 statements of the paper" in main and "(2 claims of evidence;" in main
     assert "1 supported, 0 not supported, 0 equivalent, 1 inconclusive" in main
     assert "| S1 | A beats B (Sec. I) | setup of A-1 (A-1: supported) | **supported** |" in main
     assert "| S2 | C may fail (Sec. II; hedged) | not shown on: setup of Z-1" in main
@@ -341,3 +341,13 @@ def test_verify_fails_when_a_statement_of_the_paper_changes_its_verdict(tmp_path
     ok, text = vfy.verify(ref, write("more.json", [stmt, {"id": "S2", "verdict": "mixed"}]))
     assert not ok and "S2: - -> mixed" in text
     assert vfy.verify(write("old.json", None), write("new.json", [stmt]))[0]  # old reference
+
+
+def test_verify_fails_when_a_run_loses_the_statements(tmp_path):
+    claims = [_claim("A-1", "supported", -0.3, -0.5, -0.1, "bitwise")]
+    ref, run = tmp_path / "ref.json", tmp_path / "run.json"
+    data = {"config sha256": "c", "claims": [asdict(c) for c in claims]}
+    ref.write_text(json.dumps({**data, "statements": [{"id": "S1", "verdict": "supported"}]}))
+    run.write_text(json.dumps(data))
+    ok, text = vfy.verify(ref, run)
+    assert not ok and "S1: supported -> -" in text

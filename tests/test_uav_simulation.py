@@ -358,8 +358,8 @@ def test_section_budget_and_formatting(tmp_path, zero_diff):
         _no_bad_numbers(text)
     # every CI lies inside ±m (d = 0 exactly, or 0.01 m with a 0.05 m spread): equivalent
     assert [c.verdict for c in section.claims] == ["equivalent"] * 3
-    assert "m = 0.25 m (fixed in the config before the run)" in section.body
-    assert "3 of 3 CIs lie inside ±m and 0 contain 0" in section.body
+    assert "Δ = 0.25 m (fixed in the config before the run)" in section.body
+    assert "3 of 3 CIs lie inside ±Δ and 0 contain 0" in section.body
     assert "the difference of Fig. 4 (UAV-1) and Fig. 5 (UAV-2) does not appear" in section.body
     if zero_diff:
         assert "n/a" in tables["uav_paired"] and "test is undefined" in tables["uav_paired"]
@@ -376,11 +376,11 @@ def test_section_names_the_claims_decided_on_one_side():
         "CIs on one side of 0: UAV-1 (supported), UAV-2 (supported), UAV-3 (not supported)"
         in section.body
     )
-    assert "0 of 3 CIs lie inside ±m" in section.body
+    assert "0 of 3 CIs lie inside ±Δ" in section.body
     # a larger margin turns the same data into equivalences
     section, _ = _section(_runs(-0.5 + _centred_noise(200, 0.3), tree=True), margin=2.0)
     assert [c.verdict for c in section.claims] == ["equivalent"] * 3
-    assert "m = 2 m" in section.body and "±2 m" in section.claims[0].rule
+    assert "Δ = 2 m" in section.body and "±2 m" in section.claims[0].rule
 
 
 def test_robust_range_and_clip_note():

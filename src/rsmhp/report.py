@@ -139,8 +139,8 @@ SYMBOLS = (
     "the controls û a method chooses; relative regret: regret / J(u*), in percent; pp: "
     "percentage points (a difference of two percentages). UAV (Sec. III-B): N_T sampled "
     "target trajectories; e_r the average target location error of run r (m); paired "
-    "difference d_r = e_r(A) − e_r(B), mean d̄; m: an equivalence margin fixed before the "
-    "run. CI: 95% confidence interval."
+    'difference d_r = e_r(A) − e_r(B), mean d̄ ("mean d" in the rules); Δ: an equivalence '
+    "margin fixed before the run. CI: 95% confidence interval."
 )
 
 
@@ -150,8 +150,8 @@ VERDICT_POLICY = (
     "**supported** only when the 95% confidence interval (CI) of its key number lies "
     "entirely on the claimed side (or a derived value is met within its statistical "
     "tolerance), **not supported** when the evidence lies on the opposite side or contradicts "
-    "a closed form, **equivalent** when the CI lies inside an equivalence margin ±m fixed "
-    "before the run (whatever the difference is, it is smaller than m, so the claimed effect "
+    "a closed form, **equivalent** when the CI lies inside an equivalence margin ±Δ fixed "
+    "before the run (whatever the difference is, it is smaller than Δ, so the claimed effect "
     "is absent at that resolution), and **inconclusive** otherwise. A claim cannot be marked "
     "supported while its key number's CI contains the value of the opposite claim (checked "
     "when the report is built). Where a problem or cell is left out of the evidence, the "
@@ -188,7 +188,7 @@ def _ledger(claims: list[Claim], statements: Sequence[Statement] | None) -> list
         "### Part 1: the paper's claims",
         "",
         f"{len(judgements)} statements of the paper, each tested on the paper's own setups "
-        f"({len(paper)} claims of evidence): "
+        f"({len(paper)} claims of evidence; a hedged statement also on variants): "
         + _counts((j.verdict for j in judgements), STATEMENT_VERDICTS)
         + f". A general statement's verdict, {GENERAL_RULE.text()}. A hedged one ('may'): "
         f"{HEDGED_RULE.text()}; the table names where it was and was not shown."

@@ -180,9 +180,9 @@ def load_statements(path: str | os.PathLike) -> dict[str, str]:
 
 
 def statement_flips(reference: dict[str, str], run: dict[str, str]) -> list[str]:
-    """``S5: mixed -> supported`` for every statement both files judge differently, and
-    statements present in only one of them (when both have statements)."""
-    if not reference or not run:
+    """``S5: mixed -> supported`` for every statement the two files judge differently, and
+    statements present in only one of them (unless the reference has none at all)."""
+    if not reference:  # a reference written before the ledger had statements
         return []
     out = []
     for sid in [*reference, *(k for k in run if k not in reference)]:

@@ -213,7 +213,7 @@ def _dec2(scaling: pd.DataFrame, z: ZCheck) -> Claim | None:
         "chooses better controls as P grows; derived: mean regret κ v_H / P",
         "Not in the paper (it studies cost estimates, not the controls chosen); closed "
         "form derived here",
-        _slope_key(flat, f"flattest slope of mean regret in P ({cell_text(flat)})"),
+        _slope_key(flat, f"slope of mean regret in P whose CI reaches highest ({cell_text(flat)})"),
         rule.verdict(facts),
         rule.text(),
         measured=f"slopes {range_text(mc['slope'])} over {len(mc)} (a, H) cells, CIs "

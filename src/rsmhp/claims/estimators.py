@@ -483,7 +483,8 @@ def claim_est3(s: pd.DataFrame, cheb: pd.DataFrame) -> Claim:
         verdict=rule.verdict(facts),
         rule=rule.text(),
         measured=measured,
-        setup=SETUP,
+        part="beyond",
+        setup=f"{SETUP}, quadratic costs (outside Prop. 3's linear premise)",
     )
 
 
@@ -516,7 +517,7 @@ def claim_est4(s: pd.DataFrame) -> Claim:
         )
     return Claim(
         id="EST-4",
-        claim="In the oven LQG (estimator problems), pruning the tree to its M most likely "
+        claim="On the estimator problems, pruning the tree to its M most likely "
         "trajectories degrades the approximation of J: the pruned estimate is biased toward "
         "the NBO cost",
         paper="Sec. II: keep the M most likely trajectories per step to stop exponential "

@@ -350,7 +350,8 @@ def chebyshev_claim(summary: pd.DataFrame, eps_values: Sequence[float]) -> Claim
         verdict=CHEBYSHEV_RULE.verdict(chebyshev_facts(check)),
         rule=CHEBYSHEV_RULE.text(),
         measured=_chebyshev_measured(check, eps_values),
-        setup=SETUP,
+        part="beyond",
+        setup=f"{SETUP}, quadratic cost (outside Prop. 3's linear premise)",
     )
 
 

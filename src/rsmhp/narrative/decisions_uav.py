@@ -134,7 +134,7 @@ def _dec7_text(cid: str, c: Claim, summary: pd.DataFrame) -> str:
 def _margin_text(margin: float, regret: pd.DataFrame, base: str | None, claims) -> str:
     """Why the equivalence margin of DEC-6/DEC-7 is what it is (numbers of this run)."""
     out = (
-        f"The equivalence margin m = {param_text(margin)} pp (fixed in the config before the "
+        f"The equivalence margin Δ = {param_text(margin)} pp (fixed in the config before the "
         "run, decisions.claims.equivalence_margin_pp)"
     )
     if base is not None and (regret["model"] == base).any():

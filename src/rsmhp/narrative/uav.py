@@ -137,9 +137,9 @@ def _findings(claims: Sequence[Claim], summary: pd.DataFrame, margin: float) -> 
     half = float(np.median([(c.key.ci_high - c.key.ci_low) / 2 for c in claims] or [0.0]))
     pct = 100 * half / mean_e
     margin_text = (
-        f"The equivalence margin m = {param_text(margin)} m (fixed in the config before the "
+        f"The equivalence margin Δ = {param_text(margin)} m (fixed in the config before the "
         f"run) is {fmt(100 * margin / mean_e, 2)}% of the mean error and "
-        f"{fmt(margin / sd_e, 2)} of its run-to-run SD; a difference below m is treated as "
+        f"{fmt(margin / sd_e, 2)} of its run-to-run SD; a difference below Δ is treated as "
         "none. "
     )
     decided = [f"{c.id} ({c.verdict})" for c in claims if c.verdict in VERDICTS[:2]]
@@ -149,7 +149,7 @@ def _findings(claims: Sequence[Claim], summary: pd.DataFrame, margin: float) -> 
     ]
     n_inc = counts["inconclusive"]
     why = (
-        f"{counts['equivalent']} of {len(claims)} CIs lie inside ±m and {n_inc} "
+        f"{counts['equivalent']} of {len(claims)} CIs lie inside ±Δ and {n_inc} "
         f"{'contains' if n_inc == 1 else 'contain'} 0 without fitting inside it ({n_runs} "
         f"paired runs, CI half-width about {fmt(half, 2)} m, {fmt(pct, 2)}% of mean e)"
         + (f"; CIs on one side of 0: {', '.join(decided)}" if decided else "")
