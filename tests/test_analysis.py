@@ -473,15 +473,14 @@ def test_linear_cost_check_rejects_a_wrong_variance(linear_runs):
         analysis.linear_cost_check(linear_runs.drop(columns="estimate"), KS)
 
 
-LINEAR_OK = {
-    "max |z|": 1.0,
-    "z limit": 2.5,
+EXCEEDANCE_OK = {
     "cells": 6,
     "departing": 0,
     "above bound": 0,
     "exact above bound": 0,
     "detectable": 0.2,
 }
+LINEAR_OK = {"max |z|": 1.0, "z limit": 2.5, **EXCEEDANCE_OK}
 
 
 @pytest.mark.parametrize(
@@ -663,15 +662,6 @@ def test_fig3_facts_come_from_the_check(small):
         check.J,
     )
     assert facts["nbo_error"] == pytest.approx(12.5)  # r sigma^2 (1 + (1-a)^2) = 10 * 1.25
-
-
-EXCEEDANCE_OK = {
-    "cells": 6,
-    "departing": 0,
-    "above bound": 0,
-    "exact above bound": 0,
-    "detectable": 0.2,
-}
 
 
 @pytest.mark.parametrize(

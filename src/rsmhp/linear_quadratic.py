@@ -597,8 +597,35 @@ class QuadraticForm:
         return float(total / N**H)
 
 
+class _LinearDynamics:
+    """What :class:`LinearQuadratic` and :class:`LinearCost` share: the horizon, the state
+    dimension, the noise and the step :math:`x_{k+1} = A x_k + B u_k + w_k` of the
+    :class:`rsmhp.sampling.System` protocol (from the fields ``A``, ``B``, ``Sigma``, ``u``)."""
+
+    A: np.ndarray
+    B: np.ndarray
+    Sigma: np.ndarray
+    u: np.ndarray
+
+    @property
+    def H(self) -> int:
+        return int(self.u.shape[0])
+
+    @property
+    def d(self) -> int:
+        return int(self.A.shape[0])
+
+    @cached_property
+    def noise(self) -> GaussianNoise:
+        return GaussianNoise(self.Sigma)
+
+    def step(self, x: np.ndarray, u_k: np.ndarray, w: np.ndarray) -> np.ndarray:
+        """:math:`x_{k+1} = A x_k + B u_k + w_k`; ``x``, ``w`` shape (n, d)."""
+        return x @ self.A.T + np.asarray(u_k) @ self.B.T + w
+
+
 @dataclass(frozen=True, eq=False)
-class LinearQuadratic:
+class LinearQuadratic(_LinearDynamics):
     """A linear-Gaussian system with quadratic cost and a fixed control sequence.
 
     Implements :class:`rsmhp.sampling.System` (vectorized ``step``/``stage_cost``/
@@ -679,23 +706,8 @@ class LinearQuadratic:
         :class:`rsmhp.lqg.LQGModel` (which checks them)."""
         return cls.from_lqg(LQGModel(a=a, r=r, target=target, sigma=sigma, x0=x0), u)
 
-    @property
-    def H(self) -> int:
-        return int(self.u.shape[0])
-
-    @property
-    def d(self) -> int:
-        return int(self.A.shape[0])
-
-    @cached_property
-    def noise(self) -> GaussianNoise:
-        return GaussianNoise(self.Sigma)
-
-    # --- System protocol (vectorized over n trajectories) -------------------------------
-    def step(self, x: np.ndarray, u_k: np.ndarray, w: np.ndarray) -> np.ndarray:
-        """:math:`x_{k+1} = A x_k + B u_k + w_k`; ``x``, ``w`` shape (n, d)."""
-        return x @ self.A.T + np.asarray(u_k) @ self.B.T + w
-
+    # --- System protocol (vectorized over n trajectories): H, d, noise, step from
+    # _LinearDynamics
     def stage_cost(self, x: np.ndarray, u_k: np.ndarray) -> np.ndarray:
         """:math:`x_k^\\top Q x_k + u_k^\\top R u_k`, shape (n,)."""
         u_k = np.asarray(u_k)
@@ -748,7 +760,7 @@ def _row(x, name: str, k: int, what: str) -> np.ndarray:
 
 
 @dataclass(frozen=True, eq=False)
-class LinearCost:
+class LinearCost(_LinearDynamics):
     r"""Linear dynamics with a linear cost: the model of the paper's Prop. 3 (eq. linstate).
 
     .. math::
@@ -838,23 +850,8 @@ class LinearCost:
             u=np.full((H, 1), 0.5),
         )
 
-    @property
-    def H(self) -> int:
-        return int(self.u.shape[0])
-
-    @property
-    def d(self) -> int:
-        return int(self.A.shape[0])
-
-    @cached_property
-    def noise(self) -> GaussianNoise:
-        return GaussianNoise(self.Sigma)
-
-    # --- System protocol (vectorized over n trajectories) -------------------------------
-    def step(self, x: np.ndarray, u_k: np.ndarray, w: np.ndarray) -> np.ndarray:
-        """:math:`x_{k+1} = A x_k + B u_k + w_k`; ``x``, ``w`` shape (n, d)."""
-        return x @ self.A.T + np.asarray(u_k) @ self.B.T + w
-
+    # --- System protocol (vectorized over n trajectories): H, d, noise, step from
+    # _LinearDynamics
     def stage_cost(self, x: np.ndarray, u_k: np.ndarray) -> np.ndarray:
         """:math:`C x_k + D u_k`, shape (n,)."""
         return x @ self.C + float(self.D @ np.asarray(u_k))

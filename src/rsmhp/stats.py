@@ -20,6 +20,7 @@ from scipy import stats
 from rsmhp import guards
 
 __all__ = [
+    "DETECTABLE_GRID",
     "ExceedanceTest",
     "SlopeFit",
     "binomial_ci",
@@ -108,6 +109,11 @@ def bootstrap_ci(
     boots = stat(x[idx], axis=1)
     lo, hi = np.quantile(boots, [0.5 - level / 2, 0.5 + level / 2])
     return float(lo), float(hi)
+
+
+#: relative spread errors the pipeline searches for the power of an exceedance test
+#: (:func:`detectable_scale`; 1% steps to 50%)
+DETECTABLE_GRID = np.round(np.arange(0.01, 0.5001, 0.01), 2)
 
 
 @dataclass(frozen=True)

@@ -35,11 +35,10 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rsmhp.analysis.lqg import DETECTABLE_GRID
 from rsmhp.experiments.estimators import ABLATION_COLUMNS, build_problem
 from rsmhp.linear_quadratic import LinearQuadratic
 from rsmhp.seeding import job_rng
-from rsmhp.stats import SlopeFit, binomial_ci, detectable_scale, loglog_slope
+from rsmhp.stats import DETECTABLE_GRID, SlopeFit, binomial_ci, detectable_scale, loglog_slope
 
 __all__ = [
     "CELL",

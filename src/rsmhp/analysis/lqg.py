@@ -34,6 +34,7 @@ from rsmhp import lqg
 from rsmhp.experiments.lqg import CONVERGENCE_COLUMNS, LINEAR_COST_COLUMNS, NBO_ERROR_COLUMNS
 from rsmhp.linear_quadratic import LinearCost, LinearQuadratic
 from rsmhp.stats import (
+    DETECTABLE_GRID,
     ExceedanceTest,
     SlopeFit,
     binomial_ci,
@@ -43,9 +44,6 @@ from rsmhp.stats import (
     mean_ci,
     rmse_ci,
 )
-
-#: relative spread errors searched for the power of the exceedance test (1% steps to 50%)
-DETECTABLE_GRID = np.round(np.arange(0.01, 0.5001, 0.01), 2)
 
 __all__ = [
     "ChebyshevCheck",
