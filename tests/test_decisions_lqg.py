@@ -18,8 +18,13 @@ from scipy.optimize import minimize
 from rsmhp import designs, lqg
 from rsmhp.analysis import decisions_lqg as dec
 from rsmhp.claims import decisions_lqg as dec_claims
+from rsmhp.cost_estimators import likeliness_weights
 from rsmhp.experiments.decisions_lqg import (
+    DrawCell,
     RegretCell,
+    _shifts,
+    cell_rows,
+    draw_cells,
     regret_cells,
     run_lqg_regret,
     sobol_budget,
@@ -29,6 +34,7 @@ from rsmhp.markdown import fmt
 from rsmhp.narrative import decisions_lqg as dec_text
 from rsmhp.palette import method_colour
 from rsmhp.sampling import rollout_cost, sample_tree
+from rsmhp.seeding import job_rng
 
 MODEL = {"x0": 0.0, "r": 10.0, "target": 1.0, "sigma": 1.0}
 
@@ -253,6 +259,86 @@ def test_run_is_deterministic_and_complete():
     assert lqg.regret(u, **kw) == pytest.approx(row.regret, rel=1e-12)
     # a different seed gives different draws
     assert not run_lqg_regret(cfg, MODEL, 12, n_jobs=1).regret.equals(one.regret)
+
+
+@settings(max_examples=30, deadline=None)
+@given(
+    H=st.integers(1, 4),
+    N=st.integers(2, 6),
+    M=st.integers(1, 40),
+    pruned=st.booleans(),
+    seed=st.integers(0, 2**31),
+)
+def test_tree_shifts_are_those_of_the_enumerated_tree(H, N, M, pruned, seed):
+    """The study's e_bar of the shared-draw tree (full: separated by level; pruned: the
+    compiled pruning) against sample_tree's leaves from the same stream, for three values of
+    a at once: both weightings, and the number of leaves."""
+    a_values = [0.2, 0.5, 0.9]
+    model = lqg.LQGModel(a=0.5, r=10.0, target=1.0, sigma=0.7)
+    C = np.stack([lqg.coefficients(H, a) for a in a_values])
+    cell = DrawCell(H, "pruned" if pruned else "tree", N=N, M=M if pruned else 0)
+    n, got = _shifts(cell, C, model.noise, np.random.default_rng(seed))
+    leaves = sample_tree(
+        model, [0.0], np.zeros(H), N, np.random.default_rng(seed), max_keep=M if pruned else None
+    ).leaves
+    e = leaves.noise[:, :, 0] @ C.T  # (leaves, A)
+    lik = likeliness_weights(leaves.log_likeliness)
+    assert n == e.shape[0]
+    np.testing.assert_allclose(got["uniform"], e.mean(axis=0), rtol=1e-12, atol=1e-13)
+    np.testing.assert_allclose(got["likeliness"], lik @ e / lik.sum(), rtol=1e-10, atol=1e-12)
+
+
+@pytest.mark.parametrize("method", ["mc", "antithetic", "sobol", "cubature", "nbo"])
+def test_cell_rows_are_the_sample_argmins_of_their_draws(method):
+    """Every row against lqg.sample_argmin and lqg.regret on the replicate's own draws
+    (job_rng(seed, "decisions_lqg", H=, method=, N=, M=, P=, replicate=r), the same for every
+    a): argmin components and regret to 1e-12."""
+    H, P, reps, seed = 3, 16, 3, 5
+    a_values = [0.3, 0.7]
+    cell = DrawCell(H, method, P={"cubature": 2 * H, "nbo": 1}.get(method, P))
+    frames = cell_rows(cell, a_values, MODEL, seed, reps)
+    chol = np.array([[MODEL["sigma"]]])
+    for a in a_values:
+        kw = {"x0": MODEL["x0"], "a": a, "r": MODEL["r"], "target": MODEL["target"]}
+        df = frames[RegretCell(a, H, method, P=cell.P)]
+        for rep in range(1 if method in ("nbo", "cubature") else reps):
+            rng = job_rng(
+                seed, "decisions_lqg", H=H, method=method, N=0, M=0, P=cell.P, replicate=rep
+            )
+            if method == "nbo":
+                w, wt = np.zeros((1, H)), np.ones(1)
+            elif method == "cubature":
+                w, wt = designs.cubature(H, chol)
+            else:
+                w, wt = getattr(designs, {"mc": "monte_carlo"}.get(method, method))(rng, P, H, chol)
+            weightings = {"uniform": wt}
+            if method == "mc":
+                model = lqg.LQGModel(
+                    a=a, r=MODEL["r"], target=MODEL["target"], sigma=MODEL["sigma"]
+                )
+                weightings["likeliness"] = likeliness_weights(model.noise.logpdf(w).sum(axis=1))
+            for weighting, omega in weightings.items():
+                row = df[(df.replicate == rep) & (df.weighting == weighting)].iloc[0]
+                u_hat = lqg.sample_argmin(w, omega, **kw)
+                got = row[[f"u_hat_{k}" for k in range(H)]].to_numpy(float)
+                np.testing.assert_allclose(got, u_hat, rtol=1e-12, atol=1e-14)
+                assert row.regret == pytest.approx(lqg.regret(u_hat, **kw), rel=1e-10, abs=1e-28)
+
+
+def test_draw_cells_share_the_draws_of_every_a():
+    cfg = {
+        "a_values": [0.3, 0.5, 0.7],
+        "H_values": [2, 4],
+        "P": [10, 100],
+        "tree_N": [2, 10],
+        "pruned_N": 10,
+        "max_leaves": 10000,
+        "replicates": 3,
+        "methods": ["nbo", "mc", "sobol", "tree", "pruned"],
+    }
+    cells, groups = regret_cells(cfg), draw_cells(cfg)
+    assert len(cells) == 3 * len(groups)
+    assert {DrawCell.of(c) for c in cells} == set(groups)
 
 
 # ------------------------------------------------------------------ aggregation and claims

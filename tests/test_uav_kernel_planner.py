@@ -7,10 +7,21 @@ import math
 import numpy as np
 import pytest
 
+from rsmhp.stats import bootstrap_ci
 from rsmhp.uav import kinematics, sensor, target
 from rsmhp.uav.kernel import covariance_traces, objective
 from rsmhp.uav.kinematics import UAVParams
-from rsmhp.uav.planner import PlannerParams, PlanningProblem, plan, shift_plan
+from rsmhp.uav.planner import (
+    LBFGSB,
+    OPTIMISERS,
+    BoxQN,
+    PlannerParams,
+    PlanningProblem,
+    SampledCostPlanner,
+    plan,
+    polish,
+    shift_plan,
+)
 from rsmhp.uav.sensor import SensorModel
 from rsmhp.uav.target import TargetModel
 from rsmhp.uav.tracker import Tracker
@@ -129,3 +140,87 @@ def test_optimizer_decreases_objective_vs_warm_start(rng):
 def test_shift_plan():
     u = np.arange(12.0).reshape(6, 2)
     np.testing.assert_array_equal(shift_plan(u), np.vstack([u[1:], u[-1:]]))
+
+
+# ------------------------------------------------------------------ compiled optimiser
+
+
+def _belief_problem(rng, sensor_model, n_t):
+    uav_state = np.array([*rng.uniform(-300, 300, 2), rng.uniform(12, 33), rng.uniform(-3, 3)])
+    x_hat = np.array([*rng.uniform(-300, 300, 2), *rng.uniform(-8, 8, 2)])
+    P_hat = np.diag([*rng.uniform(10, 3000, 2), *rng.uniform(1, 30, 2)])
+    hyp = target.sample_independent(x_hat, P_hat, 6, n_t, MODEL, rng)
+
+    def prob() -> PlanningProblem:  # a fresh problem (its counters) per optimiser
+        return PlanningProblem(uav_state, P_hat, hyp[..., :2], UAV, MODEL, sensor_model, PLANNER)
+
+    warm = rng.uniform(-1, 1, (6, 2)) * UAV.control_scale
+    return prob, warm
+
+
+@pytest.mark.parametrize("footprint", [False, True])
+def test_compiled_optimiser_decides_as_well_as_scipy(footprint):
+    """BoxQN against scipy's L-BFGS-B (same budgets, same starts) on 200 random belief states
+    (random warm starts) with 1 and 30 hypotheses: the paired difference of final costs
+    (compiled - scipy) has a 95% bootstrap interval whose upper limit is at most 0.1% of the
+    mean cost (the issue's quality rule; benchmarks/optimiser_quality.py runs it on
+    closed-loop belief states), and the compiled plan is never worse than its warm start."""
+    sens = SensorModel(0.05, 0.10, 100.0, footprint_radius=200.0) if footprint else SENSOR
+    rng = np.random.default_rng(11 if footprint else 12)
+    diffs, costs = [], []
+    for i in range(200):
+        prob, warm = _belief_problem(rng, sens, 1 if i % 2 else 30)
+        ours = BoxQN().minimise(prob(), warm)
+        ref = LBFGSB().minimise(prob(), warm)
+        assert ours.cost <= ours.cost_warm
+        assert np.all(np.abs(ours.controls) <= UAV.control_scale * (1 + 1e-12))
+        diffs.append(ours.cost - ref.cost)
+        costs.append(ref.cost)
+    d = np.array(diffs)
+    # percentile bootstrap: the differences are heavy-tailed (a different local minimum
+    # now and then, mostly in the compiled optimiser's favour), where a t interval's
+    # symmetric half-width says little about the upper side
+    _, upper = bootstrap_ci(d, np.random.default_rng(0), 10_000, 0.95)
+    assert upper <= 1e-3 * np.mean(costs), (upper, np.mean(costs))
+
+
+def test_optimiser_is_chosen_by_the_planner_params():
+    draw = lambda belief, rng: None  # noqa: E731 - never called here
+    for name, kind in (("boxqn", BoxQN), ("scipy", LBFGSB)):
+        params = PlannerParams(6, 30, 60, optimiser=name)
+        planner = SampledCostPlanner(draw, UAV, MODEL, SENSOR, params)
+        assert isinstance(planner.optimiser, kind)
+        assert OPTIMISERS[name] == planner.optimiser
+    with pytest.raises(ValueError, match=r"optimiser must be one of \['boxqn', 'scipy'\]"):
+        PlannerParams(6, 30, 60, optimiser="newton")
+    # polish uses the problem's optimiser; both land on the same cost here (a convex-enough
+    # start) within the stopping tolerance
+    for name in ("boxqn", "scipy"):
+        p = PlanningProblem(
+            np.array([0.0, 0.0, 20.0, 0.0]),
+            np.diag([900.0, 900.0, 9.0, 9.0]),
+            np.full((5, 6, 2), 150.0),
+            UAV,
+            MODEL,
+            SENSOR,
+            PlannerParams(6, 30, 60, optimiser=name),
+        )
+        x, f = polish(p, np.zeros(12), 50)
+        assert np.all(np.abs(x) <= 1.0)
+        assert f == pytest.approx(p.costs(x[None])[0], rel=1e-12)
+        assert f <= p.costs(np.zeros((1, 12)))[0]
+
+
+def test_compiled_plan_reports_its_counters():
+    rng = np.random.default_rng(5)
+    prob, warm = _belief_problem(rng, SENSOR, 20)
+    p = prob()
+    res = BoxQN().minimise(p, warm)
+    assert 1 <= res.n_kernel_calls <= PLANNER.maxfun
+    assert 0 <= res.nit <= PLANNER.maxiter
+    assert res.diagnostics["status"] in (0.0, 1.0, 2.0, 3.0, 4.0)
+    x = (res.controls / UAV.control_scale).reshape(1, -1)
+    assert res.cost == pytest.approx(p.costs(x)[0], rel=1e-12)
+    x0 = np.clip(warm / UAV.control_scale, -1, 1).reshape(1, -1)
+    assert res.cost_warm == pytest.approx(p.costs(x0)[0], rel=1e-12)
+    np.testing.assert_allclose(res.uav_path, kinematics.rollout(p.uav_state, res.controls, UAV))

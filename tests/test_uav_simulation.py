@@ -55,14 +55,15 @@ def test_same_seed_same_run(short_cfg):
 def test_methods_share_scenario_truth_and_measurement_noise(short_cfg, monkeypatch):
     setup = UAVSetup.from_config(short_cfg)
     seen: dict[str, list[np.ndarray]] = {}
-    real = simulation.sensor.measurement_noise
+    real = simulation.Stepper.advance
     current = {}
 
-    def spy(uav_xy, target_xy, sensor_model, std_normal):
-        seen.setdefault(current["m"], []).append(np.array(std_normal))
-        return real(uav_xy, target_xy, sensor_model, std_normal)
+    def spy(self, uav, x_true, x_est, P, control, w, zeta, det_u):
+        # the standard normals of the measurement noise and the truth's process noise
+        seen.setdefault(current["m"], []).append(np.concatenate([zeta, w]))
+        return real(self, uav, x_true, x_est, P, control, w, zeta, det_u)
 
-    monkeypatch.setattr(simulation.sensor, "measurement_noise", spy)
+    monkeypatch.setattr(simulation.Stepper, "advance", spy)
     steps = {}
     for name, m in uav_methods.from_config(short_cfg["methods"]).items():
         current["m"] = name

@@ -11,16 +11,20 @@ Core (model-independent)
   sampling          tree / pruned-tree / non-overlapping trajectory sampling with likeliness
   designs           fixed-budget noise designs: MC, antithetic, Sobol', cubature, Gauss-Hermite
   cost_estimators   uniform and likeliness-weighted averages, NBO
+  boxqn             compiled projected L-BFGS over [-1, 1]^n (scipy's budgets and tolerances)
   linear_quadratic  linear-Gaussian systems with quadratic cost and their exact oracles
   stats             confidence intervals (mean, RMSE, binomial) and log-log slope fits
   guards            argument checks of the public entry points (ValueError / TypeError naming
                     the argument, the value and what is allowed)
 Models
   lqg               the scalar "oven" LQG case study and all its closed forms
-  uav               UAV target tracking: kinematics, target, sensor, tracker (filterpy),
-                    kernel (numpy oracle), fused (compiled weighted cost + exact gradient),
-                    planner (Planner protocol, L-BFGS-B), methods (registry of planning
-                    methods, one module per family), simulation, recording
+  uav               UAV target tracking: kinematics, target, sensor, tracker (filterpy, the
+                    reference), stepper (compiled closed-loop step: aircraft, target,
+                    tracker), kernel (numpy oracle), fused (compiled weighted cost + exact
+                    gradient, vectorised over hypotheses; the compiled planning step),
+                    planner (Planner and Optimiser protocols: boxqn, scipy's L-BFGS-B),
+                    methods (registry of planning methods, one module per family),
+                    simulation, recording
 Stages of the pipeline (one module per model and stage)
   experiments       lqg, estimators, uav, decisions_lqg, decisions_uav: config -> tidy tables
   analysis          lqg, estimators, uav, decisions_lqg, decisions_uav: tables -> statistics
@@ -47,6 +51,7 @@ Workflow support
   parallel          joblib fan-out that honours a thread budget without oversubscribing BLAS
   pipeline          logging of rule scripts
   code_digest       content digest of the package code each rule imports (reruns never stale)
+  numba_cache       drops numba's cache of a module when a module it inlines changed
 """
 
 __version__ = "0.1.0"

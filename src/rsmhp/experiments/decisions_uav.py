@@ -17,9 +17,10 @@ warm start, same optimiser budget). Every plan is then scored on an independent 
 set of ``n_eval`` hypotheses drawn from the belief (``job_rng(seed, "decisions_uav_eval",
 model=, run=, step=)``): :math:`\hat J_{ev}(x) = \frac1{T}\sum_i c_i(x)`, with
 :math:`c_i(x) = \sum_j \mathrm{tr} P^i_j(x)` the planner's cost for hypothesis i. The
-reference plan is the best of every method's plan and of a multi-start L-BFGS-B on
-:math:`\hat J_{ev}` itself (starts: the ``polish`` best plans so far and ``random_starts``
-uniform points of the box, ``eval_maxiter`` iterations). Regret of a plan :math:`x`:
+reference plan is the best of every method's plan and of a multi-start optimisation (the
+planner's optimiser, ``uav.planner.optimiser``) of :math:`\hat J_{ev}` itself (starts: the
+``polish`` best plans so far and ``random_starts`` uniform points of the box,
+``eval_maxiter`` iterations). Regret of a plan :math:`x`:
 :math:`\hat J_{ev}(x) - \hat J_{ev}(x_{best}) \ge 0`, with Monte-Carlo standard error
 :math:`\mathrm{sd}_i(c_i(x) - c_i(x_{best}))/\sqrt T` (paired over the same hypotheses).
 Because :math:`x_{best}` is optimised on the evaluation set, the regret is biased upwards by
@@ -54,7 +55,7 @@ from rsmhp.parallel import parallel_map
 from rsmhp.seeding import job_rng
 from rsmhp.uav import fused, methods, target
 from rsmhp.uav.methods import Method
-from rsmhp.uav.planner import Belief, PlanningProblem, lbfgsb
+from rsmhp.uav.planner import Belief, PlanningProblem, polish
 from rsmhp.uav.simulation import StepInfo, UAVSetup, draw_scenario, simulate_run
 
 __all__ = [
@@ -269,7 +270,7 @@ def score_state(
             state.uav, state.P_hat, hyp.states[..., :2], *args, weights=hyp.weights
         )
         plans[name] = (res.controls.ravel() / scale, res.cost, prob)
-    # reference: multi-start L-BFGS-B on the evaluation cost
+    # reference: multi-start optimisation of the evaluation cost
     aux = job_rng(seed, "decisions_uav_aux", **ident)
     cands = np.array([p[0] for p in plans.values()])
     cand_cost = ev.costs(cands)
@@ -277,9 +278,9 @@ def score_state(
     starts += list(aux.uniform(-1.0, 1.0, (int(cfg["random_starts"]), 2 * H)))
     best_x, best_f = cands[int(np.argmin(cand_cost))], float(cand_cost.min())
     for x0 in starts:
-        res = lbfgsb(ev, x0, int(cfg["eval_maxiter"]))
-        if res.fun < best_f:
-            best_x, best_f = np.clip(res.x, -1.0, 1.0), float(res.fun)
+        x, f = polish(ev, x0, int(cfg["eval_maxiter"]))
+        if f < best_f:
+            best_x, best_f = x, f
     # per-hypothesis costs c_i of every plan and of the best, on the evaluation set
     all_x = np.vstack([cands, best_x[None, :]])
     per_hyp = fused.covariance_traces(

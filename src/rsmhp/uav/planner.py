@@ -16,15 +16,18 @@ Two protocols separate what a method decides from how it optimises:
   loop and the decision study only call this; a method that is not "hypotheses + optimiser"
   (e.g. a tree search) implements it directly.
 * :class:`Optimiser`: minimises a :class:`PlanningProblem` (a fixed weighted cost) from a
-  start; :class:`LBFGSB` (scipy) is today's. :class:`SampledCostPlanner` combines a method's
-  hypotheses with an optimiser: the planner of every sampling method.
+  start. Two: :class:`BoxQN` (the default: :mod:`rsmhp.boxqn`'s projected L-BFGS, the whole
+  optimisation in one compiled call) and :class:`LBFGSB` (scipy's L-BFGS-B, the oracle),
+  chosen by ``PlannerParams.optimiser`` (config ``uav.planner.optimiser``).
+  :class:`SampledCostPlanner` combines a method's hypotheses with an optimiser: the planner
+  of every sampling method.
 
-Value and exact gradient :math:`\nabla_x J` come from one call of the compiled kernel
-:func:`rsmhp.uav.fused.cost_and_grad` (adjoint of the covariance recursion and of the
-kinematics; no finite differences). The optimiser is scipy's L-BFGS-B with the box as bounds,
-``maxiter`` iterations and ``maxfun`` evaluations at most (identical for every method),
-started from the warm start (the previous plan shifted by one step, last control repeated;
-zeros at the first step).
+Value and exact gradient :math:`\nabla_x J` come from the compiled kernel
+(:mod:`rsmhp.uav.fused`: adjoint of the covariance recursion and of the kinematics; no finite
+differences). Both optimisers work on the box, with at most ``maxiter`` iterations and
+``maxfun`` evaluations (identical for every method), scipy's default tolerances, started from
+the warm start (the previous plan shifted by one step, last control repeated; zeros at the
+first step).
 """
 
 from __future__ import annotations
@@ -45,7 +48,9 @@ from rsmhp.uav.target import TargetModel
 
 __all__ = [
     "LBFGSB",
+    "OPTIMISERS",
     "Belief",
+    "BoxQN",
     "Optimiser",
     "PlanResult",
     "Planner",
@@ -54,28 +59,45 @@ __all__ = [
     "SampledCostPlanner",
     "lbfgsb",
     "plan",
+    "polish",
     "shift_plan",
 ]
 
 
+#: optimiser names of ``PlannerParams.optimiser`` (config ``uav.planner.optimiser``)
+OPTIMISER_NAMES = ("boxqn", "scipy")
+
+
 @dataclass(frozen=True)
 class PlannerParams:
-    """Horizon ``H`` and optimiser budget (L-BFGS-B iterations and objective evaluations)."""
+    """Horizon ``H``, optimiser budget (iterations and objective evaluations) and the
+    optimiser (``"boxqn"``: :class:`BoxQN`, ``"scipy"``: :class:`LBFGSB`)."""
 
     horizon: int
     maxiter: int
     maxfun: int
+    optimiser: str = "boxqn"
 
     def __post_init__(self) -> None:
         for name in ("horizon", "maxiter", "maxfun"):
             value = guards.positive_int(f"PlannerParams.{name}", getattr(self, name))
             object.__setattr__(self, name, value)  # 6.0 -> 6 (ints are kept as they are)
+        if self.optimiser not in OPTIMISER_NAMES:
+            raise ValueError(
+                f"PlannerParams.optimiser must be one of {list(OPTIMISER_NAMES)}, "
+                f"got {self.optimiser!r}"
+            )
 
     @classmethod
     def from_config(cls, uav: Mapping[str, Any]) -> PlannerParams:
         p = uav["planner"]
         # no int(): 6.7 is refused by the constructor rather than truncated to 6
-        return cls(horizon=p["horizon"], maxiter=p["maxiter"], maxfun=p["maxfun"])
+        return cls(
+            horizon=p["horizon"],
+            maxiter=p["maxiter"],
+            maxfun=p["maxfun"],
+            optimiser=p.get("optimiser", "boxqn"),
+        )
 
 
 @dataclass
@@ -108,10 +130,11 @@ class Belief:
 class Planner(Protocol):
     """Plans one belief state: ``plan(belief, warm_start (H, 2), rng) -> PlanResult``. ``rng``
     is the step's own stream (``job_rng(seed, ..., step=k, **method.job_key())``); a planner
-    draws every random number it needs from it."""
+    draws every random number it needs from it. The closed loop passes ``None`` for a method
+    that declares ``uses_rng = False``."""
 
     def plan(
-        self, belief: Belief, warm_start: np.ndarray, rng: np.random.Generator
+        self, belief: Belief, warm_start: np.ndarray, rng: np.random.Generator | None
     ) -> PlanResult: ...
 
 
@@ -163,7 +186,7 @@ class PlanningProblem:
         self.P_hat = np.asarray(P_hat, dtype=float)
         self.target_xy = np.asarray(target_xy, dtype=float)
         self.uav, self.target, self.sensor, self.params = uav, target, sensor, params
-        self.scale = np.tile(uav.control_scale, params.horizon)
+        self.scale = _scale(uav, params.horizon)
         self.n_kernel_calls = 0
         self._cache: tuple[np.ndarray, float, np.ndarray] | None = None
         self._frozen = fused.Frozen(
@@ -204,6 +227,14 @@ class PlanningProblem:
         f, grad = float(c[0]), g[0]
         self._cache = (x.copy(), f, grad)
         return f, grad.copy()
+
+
+@functools.cache
+def _scale(uav: UAVParams, horizon: int) -> np.ndarray:
+    """``(a_max, phi_max)`` repeated H times (2H,), read-only (one per aircraft and H)."""
+    out = np.tile(uav.control_scale, horizon)
+    out.flags.writeable = False
+    return out
 
 
 def shift_plan(controls: np.ndarray) -> np.ndarray:
@@ -270,27 +301,81 @@ def plan(problem: PlanningProblem, warm_start: np.ndarray, *, check: bool = True
 
 @dataclass(frozen=True)
 class LBFGSB:
-    """Today's optimiser: scipy's L-BFGS-B with the exact gradient over the box, at most
-    ``params.maxiter`` iterations and ``params.maxfun`` evaluations (see :func:`plan`)."""
+    """scipy's L-BFGS-B with the exact gradient over the box, at most ``params.maxiter``
+    iterations and ``params.maxfun`` evaluations (see :func:`plan`): the oracle of
+    :class:`BoxQN`, selectable with ``optimiser: scipy``."""
 
     def minimise(self, problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
         return plan(problem, warm_start, check=False)
 
 
 @dataclass(frozen=True)
+class BoxQN:
+    """The default optimiser: :func:`rsmhp.boxqn.minimise` (projected L-BFGS, scipy's budgets
+    and tolerances) on the compiled cost, from the warm start clipped into the box, in one
+    compiled call. ``diagnostics["status"]`` is its stopping reason
+    (:data:`rsmhp.boxqn.STATUS`); ``n_kernel_calls`` counts the warm start's evaluation."""
+
+    def minimise(self, problem: PlanningProblem, warm_start: np.ndarray) -> PlanResult:
+        x0 = np.clip(np.asarray(warm_start, dtype=float).ravel() / problem.scale, -1.0, 1.0)
+        p = problem.params
+        x, f, f0, nit, nfev, status = fused.minimise(x0, problem._frozen, p.maxiter, p.maxfun)
+        problem.n_kernel_calls += nfev
+        return PlanResult(
+            controls=problem.controls(x),
+            cost=f,
+            cost_warm=f0,
+            nit=nit,
+            n_kernel_calls=problem.n_kernel_calls,
+            uav_path=problem.path(x),
+            diagnostics={"status": float(status)},
+        )
+
+
+#: the optimiser of each ``PlannerParams.optimiser`` name
+OPTIMISERS: dict[str, Optimiser] = {"boxqn": BoxQN(), "scipy": LBFGSB()}
+
+
+def polish(
+    problem: PlanningProblem, x0: np.ndarray, maxiter: int, maxfun: int | None = None
+) -> tuple[np.ndarray, float]:
+    """Minimise ``problem`` from ``x0`` (2H,) with the optimiser ``problem.params.optimiser``
+    names, at most ``maxiter`` iterations and ``maxfun`` evaluations (``None``: scipy's
+    default 15000): ``(x, J(x))`` with x in the box (e.g. the open-loop reference's
+    multi-start)."""
+    guards.instance_of("problem", problem, PlanningProblem)
+    n = 2 * problem.params.horizon
+    x0 = guards.finite_array("x0", x0, shape=(n,))
+    maxiter = guards.positive_int("maxiter", maxiter)
+    maxfun = 15000 if maxfun is None else guards.positive_int("maxfun", maxfun)
+    if problem.params.optimiser == "scipy":
+        res = _lbfgsb(problem, x0, maxiter, maxfun)
+        return np.clip(res.x, -1.0, 1.0), float(res.fun)
+    x, f, _, _, nfev, _ = fused.minimise(x0, problem._frozen, maxiter, maxfun)
+    problem.n_kernel_calls += nfev
+    return x, f
+
+
+@dataclass(frozen=True)
 class SampledCostPlanner:
     """The planner of every sampling method: draw the method's weighted hypotheses for the
     belief (``draw(belief, rng)``), build the weighted cost and minimise it with
-    ``optimiser`` from the warm start."""
+    ``optimiser`` (default: the one ``params.optimiser`` names) from the warm start."""
 
     draw: Callable[[Belief, np.random.Generator], Any]
     uav: UAVParams
     target: TargetModel
     sensor: SensorModel
     params: PlannerParams
-    optimiser: Optimiser = LBFGSB()
+    optimiser: Optimiser | None = None  # None: OPTIMISERS[params.optimiser]
 
-    def plan(self, belief: Belief, warm_start: np.ndarray, rng: np.random.Generator) -> PlanResult:
+    def __post_init__(self) -> None:
+        if self.optimiser is None:
+            object.__setattr__(self, "optimiser", OPTIMISERS[self.params.optimiser])
+
+    def plan(
+        self, belief: Belief, warm_start: np.ndarray, rng: np.random.Generator | None
+    ) -> PlanResult:
         hyp = self.draw(belief, rng)
         problem = PlanningProblem(
             belief.uav,

@@ -34,7 +34,10 @@ Step k = 1..K
 -------------
 plan from (UAV state, :math:`\hat x_{k-1}, \hat P_{k-1}`) -> apply :math:`u_0` -> target moves
 :math:`x_k = F x_{k-1} + w_k` -> tracker predicts -> :math:`z_k = H x_k + v_k` -> tracker
-updates with R at the predicted estimate -> error :math:`e_k = \|\hat p_k - p_k\|`.
+updates with R at the predicted estimate -> error :math:`e_k = \|\hat p_k - p_k\|`. Everything
+after the plan is one compiled call (:class:`rsmhp.uav.stepper.Stepper`, tested step by step
+against the numpy kinematics and sensor and filterpy's Kalman filter); a method that declares
+``uses_rng = False`` (NBO) gets no planning stream.
 Metric of the run: ``mean_error`` :math:`= \frac1K \sum_k e_k` (paper's average target location
 error), ``rmse`` :math:`= (\frac1K\sum_k e_k^2)^{1/2}`, ``mean_trace`` = mean of
 :math:`\mathrm{tr}\,\hat P_k`. ``plan_seconds`` is planner wall time (the only
@@ -54,13 +57,12 @@ from threadpoolctl import threadpool_limits
 
 from rsmhp import guards
 from rsmhp.seeding import job_rng
-from rsmhp.uav import kinematics, sensor
 from rsmhp.uav.kinematics import UAVParams
 from rsmhp.uav.methods import Method
 from rsmhp.uav.planner import Belief, PlannerParams, shift_plan
 from rsmhp.uav.sensor import SensorModel
+from rsmhp.uav.stepper import Stepper
 from rsmhp.uav.target import TargetModel
-from rsmhp.uav.tracker import Tracker
 
 __all__ = [
     "Scenario",
@@ -212,6 +214,24 @@ def simulate_run(
         return _simulate_run(setup, method, seed, run, observer)
 
 
+_ROW_KEYS = (
+    "error",
+    "trace",
+    "uav_x",
+    "uav_y",
+    "uav_speed",
+    "uav_heading",
+    "target_x",
+    "target_y",
+    "est_x",
+    "est_y",
+    "accel",
+    "bank",
+    "plan_cost",
+    "plan_cost_warm",
+)
+
+
 def _simulate_run(setup, method, seed, run, observer):
     sc = draw_scenario(setup, seed, run)
     K, H = setup.steps, setup.planner.horizon
@@ -220,59 +240,48 @@ def _simulate_run(setup, method, seed, run, observer):
     zeta = job_rng(seed, "uav_measurement_noise", run=run).standard_normal((K, 2))
     limited = setup.sensor.limited
     det_u = job_rng(seed, "uav_detection", run=run).random(K) if limited else np.zeros(K)
-    n_detected = 0
-    F = setup.target.F
     x_true, uav_state = sc.target.copy(), sc.uav.copy()
-    trk = Tracker(sc.estimate, setup.P0, setup.target)
+    x_est, P_est = sc.estimate.astype(float), np.array(setup.P0, dtype=float)
+    stepper = Stepper(setup.uav, setup.target, setup.sensor)
     warm = np.zeros((H, 2))
-    rows: list[dict[str, Any]] = []
+    vals = np.empty((K, len(_ROW_KEYS)))  # one row of floats per step, dicts built at the end
+    counts = np.empty((K, 2), dtype=np.int64)  # nit, kernel calls
+    seen_k = np.ones(K, dtype=bool)
     plan_seconds = 0.0
     planner = method.planner(setup)
+    uses_rng = method.uses_rng
     for k in range(1, K + 1):
         t0 = time.perf_counter()
-        rng = job_rng(seed, "uav_plan", run=run, step=k, **method.job_key())
-        res = planner.plan(Belief(uav_state, trk.x, trk.P), warm, rng)
+        rng = job_rng(seed, "uav_plan", run=run, step=k, **method.job_key()) if uses_rng else None
+        res = planner.plan(Belief(uav_state.copy(), x_est.copy(), P_est.copy()), warm, rng)
         plan_seconds += time.perf_counter() - t0
         warm = shift_plan(res.controls)
-        uav_state = kinematics.step(uav_state, res.controls[0], setup.uav)
-        x_true = F @ x_true + w[k - 1]
-        trk.predict()
-        seen = sensor.detected(uav_state[:2], x_true[:2], setup.sensor, det_u[k - 1])
-        if seen:
-            R_est = sensor.measurement_cov(uav_state[:2], trk.x[:2], setup.sensor)
-            v = sensor.measurement_noise(uav_state[:2], x_true[:2], setup.sensor, zeta[k - 1])
-            trk.update(x_true[:2] + v, R_est, check=False)
-            n_detected += 1
-        x_est, P_est = trk.x, trk.P
-        err = float(np.hypot(*(x_est[:2] - x_true[:2])))
-        tr = float(np.trace(P_est))
-        rows.append(
-            {
-                "step": k,
-                "error": err,
-                "trace": tr,
-                "uav_x": uav_state[0],
-                "uav_y": uav_state[1],
-                "uav_speed": uav_state[2],
-                "uav_heading": uav_state[3],
-                "target_x": x_true[0],
-                "target_y": x_true[1],
-                "est_x": x_est[0],
-                "est_y": x_est[1],
-                "accel": res.controls[0, 0],
-                "bank": res.controls[0, 1],
-                "plan_cost": res.cost,
-                "plan_cost_warm": res.cost_warm,
-                "nit": res.nit,
-                "kernel_calls": res.n_kernel_calls,
-            }
+        u0 = res.controls[0]
+        seen, err, tr = stepper.advance(
+            uav_state, x_true, x_est, P_est, u0, w[k - 1], zeta[k - 1], det_u[k - 1]
         )
-        if limited:  # variant-only column: the paper's model's outputs stay as they were
-            rows[-1]["detected"] = bool(seen)
+        seen_k[k - 1] = seen
+        vals[k - 1] = (
+            err, tr, *uav_state, x_true[0], x_true[1], x_est[0], x_est[1], u0[0], u0[1],
+            res.cost, res.cost_warm,
+        )  # fmt: skip
+        counts[k - 1] = (res.nit, res.n_kernel_calls)
         if observer is not None:
             hyp = res.hypotheses.states if res.hypotheses is not None else np.zeros((0, H, 4))
-            observer(StepInfo(k, uav_state, x_true, x_est, P_est, res.uav_path, hyp, err, tr, warm))
-    errors = np.array([r["error"] for r in rows])
+            observer(
+                StepInfo(
+                    k, uav_state.copy(), x_true.copy(), x_est.copy(), P_est.copy(),
+                    res.uav_path, hyp, err, tr, warm, bool(seen),
+                )
+            )  # fmt: skip
+    rows: list[dict[str, Any]] = []
+    for k in range(K):
+        row = {"step": k + 1, **dict(zip(_ROW_KEYS, vals[k].tolist(), strict=True))}
+        row["nit"], row["kernel_calls"] = int(counts[k, 0]), int(counts[k, 1])
+        if limited:  # variant-only column: the paper's model's outputs stay as they were
+            row["detected"] = bool(seen_k[k])
+        rows.append(row)
+    errors = vals[:, 0]
     summary = {
         "method": method.name,
         "family": method.family,
@@ -282,10 +291,10 @@ def _simulate_run(setup, method, seed, run, observer):
         "mean_error": float(errors.mean()),
         "rmse": float(np.sqrt(np.mean(errors**2))),
         "final_error": float(errors[-1]),
-        "mean_trace": float(np.mean([r["trace"] for r in rows])),
-        "mean_nit": float(np.mean([r["nit"] for r in rows])),
+        "mean_trace": float(np.mean(vals[:, 1])),
+        "mean_nit": float(np.mean(counts[:, 0])),
         "plan_seconds": plan_seconds,
     }
     if limited:
-        summary["detect_rate"] = n_detected / K
+        summary["detect_rate"] = int(seen_k.sum()) / K
     return summary, rows

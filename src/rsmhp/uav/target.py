@@ -149,11 +149,28 @@ def _chol(P: np.ndarray) -> np.ndarray:
 
 def _propagate(x0: np.ndarray, w: np.ndarray, F: np.ndarray) -> np.ndarray:
     """``x0`` (n, 4), ``w`` (n, H, 4) -> states (n, H, 4) with x_j = F x_{j-1} + w_j."""
-    out = np.empty_like(w)
-    cur = x0
-    for j in range(w.shape[1]):
-        cur = cur @ F.T + w[:, j]
-        out[:, j] = cur
+    return _propagate_kernel(
+        np.ascontiguousarray(x0, dtype=float),
+        np.ascontiguousarray(w, dtype=float),
+        np.ascontiguousarray(F, dtype=float),
+        np.empty(np.shape(w)),
+    )
+
+
+@njit(cache=True, nogil=True)
+def _propagate_kernel(x0, w, F, out):  # pragma: no cover - compiled
+    """:func:`_propagate` in compiled loops: (F x)_r = sum_c F[r, c] x_c in order c = 0..3
+    (a small-matrix product written out; numpy's may sum in another order, so the two agree
+    to rounding)."""
+    for i in range(w.shape[0]):
+        c0, c1, c2, c3 = x0[i, 0], x0[i, 1], x0[i, 2], x0[i, 3]
+        for j in range(w.shape[1]):
+            n0 = F[0, 0] * c0 + F[0, 1] * c1 + F[0, 2] * c2 + F[0, 3] * c3 + w[i, j, 0]
+            n1 = F[1, 0] * c0 + F[1, 1] * c1 + F[1, 2] * c2 + F[1, 3] * c3 + w[i, j, 1]
+            n2 = F[2, 0] * c0 + F[2, 1] * c1 + F[2, 2] * c2 + F[2, 3] * c3 + w[i, j, 2]
+            n3 = F[3, 0] * c0 + F[3, 1] * c1 + F[3, 2] * c2 + F[3, 3] * c3 + w[i, j, 3]
+            c0, c1, c2, c3 = n0, n1, n2, n3
+            out[i, j, 0], out[i, j, 1], out[i, j, 2], out[i, j, 3] = c0, c1, c2, c3
     return out
 
 
@@ -219,7 +236,8 @@ def draw_independent(
     z0 = rng.standard_normal((n, 4))
     dev = z0 @ _chol(P_hat).T
     x0 = np.asarray(x_hat, dtype=float) + dev
-    w = rng.standard_normal((n, horizon, 4)) @ _chol(model.Q).T
+    # one (n H, 4) x (4, 4) product (a batched (n, H, 4) product is n small ones: 10x slower)
+    w = (rng.standard_normal((n * horizon, 4)) @ model.noise.chol.T).reshape(n, horizon, 4)
     return _propagate(x0, w, model.F), np.concatenate([dev[:, None, :], w], axis=1)
 
 

@@ -1,9 +1,14 @@
-r"""The simulation's target tracker: a linear Kalman filter (filterpy) on the NCV model.
+r"""The target tracker's reference implementation: a linear Kalman filter (filterpy) on the
+NCV model.
 
 Predict with :math:`F, Q` (:mod:`rsmhp.uav.target`); update with :math:`H = [I_2\ 0]` and the
 geometry-dependent :math:`R` (:mod:`rsmhp.uav.sensor`) evaluated by the caller at the tracker's
 *predicted* target position (the true geometry is unknown to the tracker). filterpy updates the
 covariance in Joseph form, :math:`P^+ = (I-KH)P^-(I-KH)^T + K R K^T`.
+
+The closed loop runs the same filter compiled into its step (:mod:`rsmhp.uav.stepper`: a
+filterpy call per step cost more than an NBO planning step); this class is the oracle that
+step is tested against, step by step (``tests/test_uav_stepper.py``).
 """
 
 from __future__ import annotations

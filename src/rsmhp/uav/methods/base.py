@@ -38,7 +38,7 @@ from __future__ import annotations
 import re
 from abc import ABC, abstractmethod
 from collections.abc import Mapping
-from dataclasses import asdict, dataclass, fields
+from dataclasses import InitVar, asdict, dataclass, fields
 from typing import Any, ClassVar
 
 import numpy as np
@@ -58,8 +58,13 @@ class Hypotheses:
     states: np.ndarray
     weights: np.ndarray
     noise: np.ndarray | None = None
+    #: ``False`` skips the shape and weight checks: for a generator whose output is valid by
+    #: construction (NBO's single nominal hypothesis, planned at every closed-loop step)
+    check: InitVar[bool] = True
 
-    def __post_init__(self) -> None:
+    def __post_init__(self, check: bool) -> None:
+        if not check:
+            return
         s = np.asarray(self.states, dtype=float)
         if s.ndim != 3 or s.shape[0] == 0 or s.shape[2] != 4:
             raise ValueError(f"Hypotheses.states must have shape (T, H, 4), got {s.shape}")
@@ -101,6 +106,9 @@ class Method(ABC):
     colour: ClassVar[str]
     order: ClassVar[int]
     baseline: ClassVar[bool] = False
+    #: whether the planner draws random numbers; ``False`` (a deterministic method such as
+    #: NBO) spares the closed loop building the step's stream, and the planner gets ``None``
+    uses_rng: ClassVar[bool] = True
 
     # ---------------------------------------------------------------- construction
     @classmethod

@@ -18,6 +18,9 @@ from rsmhp.uav.planner import Belief
 
 __all__ = ["NBO"]
 
+_ONE = np.ones(1)
+_ONE.flags.writeable = False
+
 
 @register
 @dataclass(frozen=True)
@@ -35,6 +38,7 @@ class NBO(Method):
     colour: ClassVar[str] = METHOD_COLOURS["nbo"]
     order: ClassVar[int] = 0
     baseline: ClassVar[bool] = True
+    uses_rng: ClassVar[bool] = False
     name_pattern: ClassVar[str] = "nbo"
     n_traj: ClassVar[int] = 1
 
@@ -47,7 +51,7 @@ class NBO(Method):
     def name(self) -> str:
         return "nbo"
 
-    def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator) -> Hypotheses:
+    def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator | None) -> Hypotheses:
         H = setup.planner.horizon
         states = target.nominal(belief.x_hat, H, setup.target, check=False)
-        return Hypotheses(states, np.ones(1), np.zeros((1, H + 1, 4)))
+        return Hypotheses(states, _ONE, np.zeros((1, H + 1, 4)), check=False)
