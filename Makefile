@@ -33,7 +33,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	@# compile the numba planner kernels once per machine (on-disk cache; every job loads it)
-	$(BIN)/python -c 'from rsmhp.uav import fused; print(f"planner kernels compiled in {fused.warm_up():.1f} s")'
+	$(BIN)/python -c 'from rsmhp.uav import fused; from rsmhp.experiments import decisions_lqg as d; print(f"compiled kernels ready in {fused.warm_up() + d.warm_up():.1f} s")'
 	@touch $(STAMP)
 
 setup: $(STAMP)

@@ -161,6 +161,9 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=3, help="timed closed-loop runs per method")
     ap.add_argument("--methods", nargs="*", help="default: every method of the default config")
     ap.add_argument("--cell", default="r1c1", help="the decision-map cell of the rules part")
+    ap.add_argument(
+        "--rules", nargs="*", default=["decisions_lqg", "cell"], help="rules part: which rules"
+    )
     args = ap.parse_args()
     sys.path.insert(0, str(ROOT / "src"))
     import yaml
@@ -188,7 +191,8 @@ def main() -> None:
                 flush=True,
             )
     if "rules" in args.parts:
-        for part in ("decisions_lqg", args.cell):
+        parts = [p for p in ("decisions_lqg", "cell") if p in args.rules]
+        for part in (args.cell if p == "cell" else p for p in parts):
             ours, base = _pair(args.baseline, RULES, part)
             label = "decisions_lqg (2 workers)" if part == "decisions_lqg" else f"map cell {part}"
             print(_line(label, ours, base, "s", "{:.1f}"), flush=True)

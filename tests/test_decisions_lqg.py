@@ -3,6 +3,7 @@ against them (tolerances from the chi-square variance of the regret)."""
 
 from __future__ import annotations
 
+import itertools
 import re
 
 import matplotlib.pyplot as plt
@@ -272,51 +273,52 @@ def test_run_is_deterministic_and_complete():
 def test_tree_shifts_are_those_of_the_enumerated_tree(H, N, M, pruned, seed):
     """The study's e_bar of the shared-draw tree (full: separated by level; pruned: the
     compiled pruning) against sample_tree's leaves from the same stream, for three values of
-    a at once: both weightings, and the number of leaves."""
+    a at once and for every horizon h <= H from the draws of H levels (a tree of h levels
+    is the first h levels of the process): both weightings, and the number of leaves."""
     a_values = [0.2, 0.5, 0.9]
     model = lqg.LQGModel(a=0.5, r=10.0, target=1.0, sigma=0.7)
-    C = np.stack([lqg.coefficients(H, a) for a in a_values])
-    cell = DrawCell(H, "pruned" if pruned else "tree", N=N, M=M if pruned else 0)
-    n, got = _shifts(cell, C, model.noise, np.random.default_rng(seed))
-    leaves = sample_tree(
-        model, [0.0], np.zeros(H), N, np.random.default_rng(seed), max_keep=M if pruned else None
-    ).leaves
-    e = leaves.noise[:, :, 0] @ C.T  # (leaves, A)
-    lik = likeliness_weights(leaves.log_likeliness)
-    assert n == e.shape[0]
-    np.testing.assert_allclose(got["uniform"], e.mean(axis=0), rtol=1e-12, atol=1e-13)
-    np.testing.assert_allclose(got["likeliness"], lik @ e / lik.sum(), rtol=1e-10, atol=1e-12)
+    C = {h: np.stack([lqg.coefficients(h, a) for a in a_values]) for h in range(1, H + 1)}
+    cell = DrawCell("pruned" if pruned else "tree", N=N, M=M if pruned else 0, H=tuple(C))
+    got = _shifts(cell, C, model.noise, np.random.default_rng(seed))
+    for h in C:
+        rng = np.random.default_rng(seed)
+        leaves = sample_tree(model, [0.0], np.zeros(h), N, rng, max_keep=M if pruned else None)
+        e = leaves.leaves.noise[:, :, 0] @ C[h].T  # (leaves, A)
+        lik = likeliness_weights(leaves.leaves.log_likeliness)
+        n, by = got[h]
+        assert n == e.shape[0]
+        np.testing.assert_allclose(by["uniform"], e.mean(axis=0), rtol=1e-12, atol=1e-13)
+        np.testing.assert_allclose(by["likeliness"], lik @ e / lik.sum(), rtol=1e-10, atol=1e-12)
 
 
 @pytest.mark.parametrize("method", ["mc", "antithetic", "sobol", "cubature", "nbo"])
 def test_cell_rows_are_the_sample_argmins_of_their_draws(method):
     """Every row against lqg.sample_argmin and lqg.regret on the replicate's own draws
-    (job_rng(seed, "decisions_lqg", H=, method=, N=, M=, P=, replicate=r), the same for every
-    a): argmin components and regret to 1e-12."""
-    H, P, reps, seed = 3, 16, 3, 5
+    (job_rng(seed, "decisions_lqg", method=, N=, M=, P=, replicate=r), the same for every a;
+    a horizon H uses the first H steps of the longest): argmins and regret to 1e-12."""
+    H_max, P, reps, seed = 3, 16, 3, 5
     a_values = [0.3, 0.7]
-    cell = DrawCell(H, method, P={"cubature": 2 * H, "nbo": 1}.get(method, P))
+    horizons = (H_max,) if method == "cubature" else (2, H_max)
+    cell = DrawCell(method, P={"cubature": 2 * H_max, "nbo": 1}.get(method, P), H=horizons)
     frames = cell_rows(cell, a_values, MODEL, seed, reps)
     chol = np.array([[MODEL["sigma"]]])
-    for a in a_values:
+    for a, H in itertools.product(a_values, horizons):
         kw = {"x0": MODEL["x0"], "a": a, "r": MODEL["r"], "target": MODEL["target"]}
         df = frames[RegretCell(a, H, method, P=cell.P)]
         for rep in range(1 if method in ("nbo", "cubature") else reps):
-            rng = job_rng(
-                seed, "decisions_lqg", H=H, method=method, N=0, M=0, P=cell.P, replicate=rep
-            )
+            rng = job_rng(seed, "decisions_lqg", method=method, N=0, M=0, P=cell.P, replicate=rep)
             if method == "nbo":
                 w, wt = np.zeros((1, H)), np.ones(1)
             elif method == "cubature":
                 w, wt = designs.cubature(H, chol)
             else:
-                w, wt = getattr(designs, {"mc": "monte_carlo"}.get(method, method))(rng, P, H, chol)
+                draw = getattr(designs, {"mc": "monte_carlo"}.get(method, method))
+                w, wt = draw(rng, P, H_max, chol)
+                w = w[:, :H]  # the first H steps of draws for the longest horizon
             weightings = {"uniform": wt}
             if method == "mc":
-                model = lqg.LQGModel(
-                    a=a, r=MODEL["r"], target=MODEL["target"], sigma=MODEL["sigma"]
-                )
-                weightings["likeliness"] = likeliness_weights(model.noise.logpdf(w).sum(axis=1))
+                noise = lqg.LQGModel(a=a, r=1.0, target=0.0, sigma=MODEL["sigma"]).noise
+                weightings["likeliness"] = likeliness_weights(noise.logpdf(w).sum(axis=1))
             for weighting, omega in weightings.items():
                 row = df[(df.replicate == rep) & (df.weighting == weighting)].iloc[0]
                 u_hat = lqg.sample_argmin(w, omega, **kw)
@@ -325,7 +327,7 @@ def test_cell_rows_are_the_sample_argmins_of_their_draws(method):
                 assert row.regret == pytest.approx(lqg.regret(u_hat, **kw), rel=1e-10, abs=1e-28)
 
 
-def test_draw_cells_share_the_draws_of_every_a():
+def test_draw_cells_share_the_draws_of_every_a_and_horizon():
     cfg = {
         "a_values": [0.3, 0.5, 0.7],
         "H_values": [2, 4],
@@ -337,8 +339,12 @@ def test_draw_cells_share_the_draws_of_every_a():
         "methods": ["nbo", "mc", "sobol", "tree", "pruned"],
     }
     cells, groups = regret_cells(cfg), draw_cells(cfg)
-    assert len(cells) == 3 * len(groups)
-    assert {DrawCell.of(c) for c in cells} == set(groups)
+    by_key = {(g.method, g.N, g.M, g.P): g for g in groups}
+    for c in cells:  # every cell belongs to exactly one group, which lists its horizon
+        assert c.H in by_key[DrawCell.key(c)].H
+    assert sum(len(g.H) for g in groups) * 3 == len(cells)
+    assert by_key[("mc", 0, 0, 10)].H == (2, 4)
+    assert by_key[("tree", 2, 0, 0)].H == (2, 4) and by_key[("tree", 10, 0, 0)].H == (2, 4)
 
 
 # ------------------------------------------------------------------ aggregation and claims

@@ -37,7 +37,7 @@ def test_lqg_estimate_bounds_the_measured_peak(P, H):
 
 @pytest.mark.parametrize("H", [2, 6])
 def test_decision_cell_estimate_bounds_the_measured_peak(H):
-    cell = decisions_lqg.DrawCell(H, "mc", P=20000)
+    cell = decisions_lqg.DrawCell("mc", P=20000, H=(H,))
     model = {k: MODEL[k] for k in ("x0", "r", "target", "sigma")}
     peak = _peak(lambda: decisions_lqg.cell_rows(cell, [0.3, 0.5, 0.7], model, 1, 1))
     assert peak <= working_set_bytes(cell.P, H) <= 3 * peak + FIXED_BYTES

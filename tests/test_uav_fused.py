@@ -270,7 +270,10 @@ def test_both_layouts_match_the_oracle_and_each_other(rng, n_t, limited):
 
 @njit(cache=True)
 def _scalar_layout(x, st, cfg, p0, q, sens, tx, ty, wts, ws, grad):
-    return fused._value_grad_scalar(x, st, cfg, p0, q, sens, tx, ty, wts, ws, True, grad)
+    return fused._value_grad_scalar(
+        x, st, cfg, p0, q, sens, tx, ty, wts,
+        ws[6], ws[7], ws[8], ws[9], ws[10], ws[11], ws[12], True, grad,
+    )  # fmt: skip
 
 
 @njit(cache=True)

@@ -31,6 +31,7 @@ rule decisions_lqg:
         "results/logs/decisions_lqg.log",
     benchmark:
         "results/benchmarks/decisions_lqg.tsv"
+    priority: PRIORITY["decisions_lqg"]
     conda:
         ENV
     threads: THREADS
@@ -81,6 +82,7 @@ rule decisions_uav:
         "results/logs/decisions_uav.log",
     benchmark:
         "results/benchmarks/decisions_uav.tsv"
+    priority: PRIORITY["decisions_uav"]
     conda:
         ENV
     threads: THREADS
@@ -105,6 +107,7 @@ rule decisions_map_cell:
         "results/logs/decisions_map_cell/{cell}.log",
     benchmark:
         "results/benchmarks/decisions_map_cell/{cell}.tsv"
+    priority: PRIORITY["decisions_map_cell"]
     conda:
         ENV
     threads: 1

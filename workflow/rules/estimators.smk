@@ -42,6 +42,7 @@ rule estimators_ablation:
         "results/logs/estimators_ablation.log",
     benchmark:
         "results/benchmarks/estimators_ablation.tsv"
+    priority: PRIORITY["estimators_ablation"]
     conda:
         ENV
     threads: THREADS
@@ -69,6 +70,7 @@ rule estimators_summary:
         "results/logs/estimators_summary.log",
     benchmark:
         "results/benchmarks/estimators_summary.tsv"
+    priority: PRIORITY["estimators_summary"]
     conda:
         ENV
     threads: 1
@@ -96,6 +98,7 @@ rule estimators_figures:
         "results/logs/estimators_figures.log",
     benchmark:
         "results/benchmarks/estimators_figures.tsv"
+    priority: PRIORITY["estimators_figures"]
     conda:
         ENV
     threads: THREADS

@@ -23,6 +23,7 @@ rule lqg_convergence:
         "results/logs/lqg_convergence.log",
     benchmark:
         "results/benchmarks/lqg_convergence.tsv"
+    priority: PRIORITY["lqg_convergence"]
     conda:
         ENV
     threads: THREADS
@@ -49,6 +50,7 @@ rule lqg_nbo_error:
         "results/logs/lqg_nbo_error.log",
     benchmark:
         "results/benchmarks/lqg_nbo_error.tsv"
+    priority: PRIORITY["lqg_nbo_error"]
     conda:
         ENV
     threads: THREADS
@@ -71,6 +73,7 @@ rule lqg_linear_cost:
         "results/logs/lqg_linear_cost.log",
     benchmark:
         "results/benchmarks/lqg_linear_cost.tsv"
+    priority: PRIORITY["lqg_linear_cost"]
     conda:
         ENV
     threads: 1
@@ -100,6 +103,7 @@ rule lqg_summary:
         "results/logs/lqg_summary.log",
     benchmark:
         "results/benchmarks/lqg_summary.tsv"
+    priority: PRIORITY["lqg_summary"]
     conda:
         ENV
     threads: 1

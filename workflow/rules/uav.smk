@@ -40,6 +40,7 @@ rule uav_simulate:
         "results/logs/uav_simulate/{method}_{chunk}.log",
     benchmark:
         "results/benchmarks/uav_simulate/{method}_{chunk}.tsv"
+    priority: PRIORITY["uav_simulate"]
     conda:
         ENV
     threads: 1

@@ -26,9 +26,11 @@ cubature) or ``likeliness`` (:math:`\omega_i \propto` the sequence's density, fo
 and pruned; the two weightings of one replicate use the same draws).
 
 Replicate ``r`` of cell (a, H, method, N, M, P) draws from
-``job_rng(seed, "decisions_lqg", H=, method=, N=, M=, P=, replicate=r)``: the same draws for
-every a (common random numbers; the a values differ only in the coefficients c). nbo and
-cubature are deterministic (one replicate).
+``job_rng(seed, "decisions_lqg", method=, N=, M=, P=, replicate=r)`` (P = 0 for the full tree,
+whose P = N^H depends on H): draws for the longest horizon of the config, of which a cell of
+horizon H uses the first H steps, shared by every a (common random numbers; the a values
+differ only in the coefficients c, the horizons in how many steps they use). nbo and cubature
+are deterministic (one replicate).
 
 Speed: the sample-average argmin depends on a sample only through its weighted mean
 final-state noise :math:`\bar e`, so each replicate computes :math:`\bar e` for every a and
@@ -67,6 +69,7 @@ __all__ = [
     "regret_cells",
     "run_lqg_regret",
     "sobol_budget",
+    "warm_up",
 ]
 
 log = logging.getLogger(__name__)
@@ -140,23 +143,29 @@ def regret_cells(cfg: Mapping[str, Any]) -> list[RegretCell]:
 
 @dataclass(frozen=True)
 class DrawCell:
-    """The (H, method, N, M, P) of a regret cell without ``a``: its draws serve every ``a``
-    (common random numbers across the a values; only the coefficients c(a) differ)."""
+    """Regret cells that share their draws: one (method, N, M, P) for every ``a`` and every
+    horizon in ``H`` (a cell of horizon H uses the first H steps of draws made for the
+    longest; the full tree's P = N^H is per horizon, so its ``P`` here is 0). Common random
+    numbers across a and H: each cell's sample is distributed as before, cells of one
+    (method, N, M, P) are correlated, which no statistic of the study pools over."""
 
-    H: int
     method: str
     N: int = 0
     M: int = 0
     P: int = 1
+    H: tuple[int, ...] = ()
 
-    @classmethod
-    def of(cls, cell: RegretCell) -> DrawCell:
-        return cls(cell.H, cell.method, cell.N, cell.M, cell.P)
+    @staticmethod
+    def key(cell: RegretCell) -> tuple[str, int, int, int]:
+        return (cell.method, cell.N, cell.M, 0 if cell.method == "tree" else cell.P)
 
 
 def draw_cells(cfg: Mapping[str, Any]) -> list[DrawCell]:
-    """The distinct :class:`DrawCell` of :func:`regret_cells`, in first-seen order."""
-    return list(dict.fromkeys(DrawCell.of(c) for c in regret_cells(cfg)))
+    """The :class:`DrawCell` groups of :func:`regret_cells`, in first-seen order."""
+    groups: dict[tuple[str, int, int, int], set[int]] = {}
+    for c in regret_cells(cfg):
+        groups.setdefault(DrawCell.key(c), set()).add(c.H)
+    return [DrawCell(*k, H=tuple(sorted(hs))) for k, hs in groups.items()]
 
 
 @njit(cache=True, nogil=True)
@@ -181,11 +190,21 @@ def _pruned_leaves(w, ll_w, C, max_keep):  # pragma: no cover - compiled
             # top_m's set in O(n): every entry above the M-th largest value, then of those
             # equal to it the first ones in index order (top_m breaks ties by index), in
             # tree order
-            neg = -llc
-            kth = np.partition(neg, max_keep - 1)[max_keep - 1]
-            above = np.flatnonzero(neg < kth)
-            tied = np.flatnonzero(neg == kth)[: max_keep - above.size]
-            keep = np.sort(np.concatenate((above, tied)))
+            kth = np.partition(llc, n_child - max_keep)[n_child - max_keep]
+            keep = np.empty(max_keep, dtype=np.int64)
+            n_above = 0
+            for j in range(n_child):
+                n_above += llc[j] > kth
+            n_tied = max_keep - n_above  # of the entries equal to kth, the first ones
+            m = 0
+            for j in range(n_child):  # one pass in index order: tree order, no sort
+                if llc[j] > kth:
+                    keep[m] = j
+                    m += 1
+                elif llc[j] == kth and n_tied > 0:
+                    keep[m] = j
+                    m += 1
+                    n_tied -= 1
         else:
             keep = np.arange(n_child)
         e_new = np.empty((A, keep.size))
@@ -199,100 +218,127 @@ def _pruned_leaves(w, ll_w, C, max_keep):  # pragma: no cover - compiled
 
 
 def _shifts(
-    cell: DrawCell, C: np.ndarray, noise: GaussianNoise, rng: np.random.Generator | None
-) -> tuple[int, dict[str, np.ndarray]]:
-    r"""One replicate's draws of ``cell`` and, per weighting, the weighted mean final-state
-    noise :math:`\bar e = \sum_i \omega_i c^\top w^i / \sum_i \omega_i` for every row c of
-    ``C`` (A, H): (number of sequences, {weighting: (A,)})."""
-    H, chol = cell.H, noise.chol
+    cell: DrawCell,
+    C: Mapping[int, np.ndarray],
+    noise: GaussianNoise,
+    rng: np.random.Generator | None,
+) -> dict[int, tuple[int, dict[str, np.ndarray]]]:
+    r"""One replicate's draws of ``cell`` (for its longest horizon) and, for every horizon H
+    of ``C`` (H -> coefficient rows (A, H), one per a) and weighting, the weighted mean
+    final-state noise :math:`\bar e = \sum_i \omega_i c^\top w^i / \sum_i \omega_i` of the
+    first H steps: {H: (number of sequences, {weighting: (A,)})}."""
+    H_max, chol = max(C), noise.chol
+    out: dict[int, tuple[int, dict[str, np.ndarray]]] = {}
     if cell.method in ("tree", "pruned"):
         # N draws per level shared by every node (sample_tree's order: level by level)
-        w = np.stack([noise.sample(rng, cell.N)[:, 0] for _ in range(H)])  # (H, N)
+        w = np.stack([noise.sample(rng, cell.N)[:, 0] for _ in range(H_max)])  # (H, N)
         ll_w = noise.logpdf(w[:, :, None])  # (H, N)
-        if cell.method == "tree":
-            # every level's draw sits in N^(H-1) of the N^H leaves, and a leaf's likeliness
-            # is a product over levels: both weighted means separate by level (exactly)
-            lik = likeliness_weights(ll_w, axis=1)
-            uniform = C @ w.mean(axis=1)
-            weighted = C @ ((lik * w).sum(axis=1) / lik.sum(axis=1))
-            return cell.N**H, {"uniform": uniform, "likeliness": weighted}
-        ll, e = _pruned_leaves(w, ll_w, np.ascontiguousarray(C), cell.M)
-        lik = likeliness_weights(ll)
-        return ll.size, {"uniform": e.mean(axis=1), "likeliness": e @ lik / lik.sum()}
+        lik = likeliness_weights(ll_w, axis=1)
+        level_mean = w.mean(axis=1)
+        level_weighted = (lik * w).sum(axis=1) / lik.sum(axis=1)
+        for H, CH in C.items():
+            if cell.method == "tree":
+                # every level's draw sits in N^(H-1) of the N^H leaves, and a leaf's
+                # likeliness is a product over levels: both weighted means separate by level
+                got = {"uniform": CH @ level_mean[:H], "likeliness": CH @ level_weighted[:H]}
+                out[H] = (cell.N**H, got)
+                continue
+            # the pruning of the first H levels does not depend on later levels
+            ll, e = _pruned_leaves(w[:H], ll_w[:H], np.ascontiguousarray(CH), cell.M)
+            q = likeliness_weights(ll)
+            out[H] = (ll.size, {"uniform": e.mean(axis=1), "likeliness": e @ q / q.sum()})
+        return out
     if cell.method == "nbo":
-        return 1, {"uniform": np.zeros(C.shape[0])}
-    if cell.method == "cubature":
+        return {H: (1, {"uniform": np.zeros(CH.shape[0])}) for H, CH in C.items()}
+    if cell.method == "cubature":  # 2H points of its own per horizon (one horizon per cell)
+        (H,) = C
         w, wt = designs.cubature(H, chol)
     elif cell.method in ("antithetic", "sobol"):
-        w, wt = getattr(designs, cell.method)(rng, cell.P, H, chol)
+        w, wt = getattr(designs, cell.method)(rng, cell.P, H_max, chol)
     elif cell.method == "mc":
-        w, wt = designs.monte_carlo(rng, cell.P, H, chol)
+        w, wt = designs.monte_carlo(rng, cell.P, H_max, chol)
     else:
         raise ValueError(f"unknown method {cell.method!r}")
-    e = w[:, :, 0] @ C.T  # (n, A)
-    out = {"uniform": wt @ e / wt.sum()}
+    w = w[:, :, 0]  # (n, H_max); a sequence of the first H steps is w[:, :H]
     if cell.method in WEIGHTED:
-        lik = likeliness_weights(noise.logpdf(w).sum(axis=1))
-        out["likeliness"] = lik @ e / lik.sum()
-    return w.shape[0], out
+        loglik = np.cumsum(noise.logpdf(w[:, :, None]), axis=1)  # (n, H_max)
+    for H, CH in C.items():
+        e = w[:, :H] @ CH.T  # (n, A)
+        got = {"uniform": wt @ e / wt.sum()}
+        if cell.method in WEIGHTED:
+            q = likeliness_weights(loglik[:, H - 1])
+            got["likeliness"] = q @ e / q.sum()
+        out[H] = (w.shape[0], got)
+    return out
 
 
 def cell_rows(
     cell: DrawCell, a_values: list[float], params: Mapping[str, float], seed: int, reps: int
 ) -> dict[RegretCell, pd.DataFrame]:
-    r"""The rows of ``cell`` for every ``a`` in ``a_values``: per replicate and weighting the
-    regret of the sample-average argmin, the shift :math:`\bar e` and the argmin's
-    components. ``params`` is the ``lqg.model`` config section (x0, r, target, sigma).
+    r"""The rows of ``cell`` for every ``a`` in ``a_values`` and every horizon of the cell:
+    per replicate and weighting the regret of the sample-average argmin, the shift
+    :math:`\bar e` and the argmin's components. ``params`` is the ``lqg.model`` config
+    section (x0, r, target, sigma).
 
     The sample-average argmin depends on the draws only through :math:`\bar e`
     (:func:`rsmhp.lqg.sample_argmin`): :math:`\hat u = r a (T - b^H x_0 - \bar e)\, c / (1 +
     r a^2 |c|^2)` (Sherman-Morrison), and its regret is the exact quadratic form of
     :func:`rsmhp.lqg.regret`; both are evaluated for all replicates at once."""
-    A = len(a_values)
-    H = cell.H
     noise = lqg.LQGModel.from_config(params, a=float(a_values[0])).noise
-    C = np.stack([lqg.coefficients(H, float(a)) for a in a_values])  # (A, H)
+    C = {H: np.stack([lqg.coefficients(H, float(a)) for a in a_values]) for H in cell.H}
     n_reps = 1 if cell.method in DETERMINISTIC else reps
     rngs = job_rngs(
         seed, "decisions_lqg", "replicate", range(n_reps),
-        H=H, method=cell.method, N=cell.N, M=cell.M, P=cell.P,
+        method=cell.method, N=cell.N, M=cell.M, P=cell.P,
     )  # fmt: skip
     weightings = ("uniform", "likeliness") if cell.method in WEIGHTED else ("uniform",)
-    shifts = np.empty((n_reps, len(weightings), A))
-    n_seq = 0
+    shifts = {H: np.empty((n_reps, len(weightings), len(a_values))) for H in cell.H}
+    n_seq = dict.fromkeys(cell.H, 0)
     for rep, rng in enumerate(rngs):
-        n_seq, got = _shifts(cell, C, noise, None if cell.method in DETERMINISTIC else rng)
-        for j, weighting in enumerate(weightings):
-            shifts[rep, j] = got[weighting]
+        got = _shifts(cell, C, noise, None if cell.method in DETERMINISTIC else rng)
+        for H, (n, by_weighting) in got.items():
+            n_seq[H] = n
+            for j, weighting in enumerate(weightings):
+                shifts[H][rep, j] = by_weighting[weighting]
     out: dict[RegretCell, pd.DataFrame] = {}
-    x0, r, target = params["x0"], params["r"], params["target"]
-    for ia, a in enumerate(a_values):
-        a = float(a)
-        c = C[ia]
-        cc = float(np.dot(c, c))
-        e_bar = shifts[:, :, ia]  # (reps, weightings)
-        gain = r * a / (1.0 + r * a * a * cc)
-        u_hat = (gain * (target - (1.0 - a) ** H * x0 - e_bar))[..., None] * c  # (reps, W, H)
-        d = u_hat - lqg.optimal_controls(H, x0=x0, a=a, r=r, target=target)
-        regret = (d * d).sum(axis=-1) + r * a * a * (d @ c) ** 2
-        key = RegretCell(a, H, cell.method, cell.N, cell.M, cell.P)
-        n_rows = n_reps * len(weightings)  # replicate-major, then weighting
-        frame = {
-            "problem": [key.problem] * n_rows,
-            "a": np.full(n_rows, a),
-            "H": np.full(n_rows, H),
-            "method": [cell.method] * n_rows,
-            "weighting": list(weightings) * n_reps,
-            "N": np.full(n_rows, cell.N),
-            "M": np.full(n_rows, cell.M),
-            "P": np.full(n_rows, n_seq),
-            "replicate": np.repeat(np.arange(n_reps), len(weightings)),
-            "regret": regret.ravel(),
-            "shift": e_bar.ravel(),
-        }
-        frame.update({f"u_hat_{k}": u_hat[:, :, k].ravel() for k in range(H)})
-        out[key] = pd.DataFrame(frame)
+    for H in cell.H:
+        for ia, a in enumerate(a_values):
+            key = RegretCell(float(a), H, cell.method, cell.N, cell.M, n_seq[H])
+            out[key] = _frame(key, C[H][ia], shifts[H][:, :, ia], weightings, params)
     return out
+
+
+def _frame(
+    cell: RegretCell,
+    c: np.ndarray,
+    e_bar: np.ndarray,
+    weightings: tuple[str, ...],
+    params: Mapping[str, float],
+) -> pd.DataFrame:
+    """The rows of one regret cell from its shifts ``e_bar`` (replicates, weightings)."""
+    a, H = cell.a, cell.H
+    x0, r, target = params["x0"], params["r"], params["target"]
+    gain = r * a / (1.0 + r * a * a * float(np.dot(c, c)))
+    u_hat = (gain * (target - (1.0 - a) ** H * x0 - e_bar))[..., None] * c  # (reps, W, H)
+    d = u_hat - lqg.optimal_controls(H, x0=x0, a=a, r=r, target=target)
+    regret = (d * d).sum(axis=-1) + r * a * a * (d @ c) ** 2
+    n_reps = e_bar.shape[0]
+    n_rows = n_reps * len(weightings)  # replicate-major, then weighting
+    frame = {
+        "problem": [cell.problem] * n_rows,
+        "a": np.full(n_rows, a),
+        "H": np.full(n_rows, H),
+        "method": [cell.method] * n_rows,
+        "weighting": list(weightings) * n_reps,
+        "N": np.full(n_rows, cell.N),
+        "M": np.full(n_rows, cell.M),
+        "P": np.full(n_rows, cell.P),
+        "replicate": np.repeat(np.arange(n_reps), len(weightings)),
+        "regret": regret.ravel(),
+        "shift": e_bar.ravel(),
+    }
+    frame.update({f"u_hat_{k}": u_hat[:, :, k].ravel() for k in range(H)})
+    return pd.DataFrame(frame)
 
 
 def _task(job: tuple[list[DrawCell], list[float], Mapping[str, float], int, int]) -> list:
@@ -353,7 +399,10 @@ def run_lqg_regret(
     groups = draw_cells(cfg)
     a_values = [float(a) for a in cfg["a_values"]]
     reps = int(cfg["replicates"])
-    cost = [(1 if c.method in DETERMINISTIC else reps) * c.P * c.H for c in groups]
+    cost = [
+        (1 if g.method in DETERMINISTIC else reps) * max(g.P, g.N ** max(g.H)) * sum(g.H)
+        for g in groups
+    ]
     # expensive cells first, dealt round-robin into tasks (never changes a number)
     ordered = [groups[i] for i in sorted(range(len(groups)), key=lambda i: -cost[i])]
     n_tasks = max(1, min(len(groups), 2 * n_jobs))
@@ -376,3 +425,12 @@ def run_lqg_regret(
     # rows in cell order (as regret_cells lists them), then replicate, then weighting
     out = pd.concat([by_cell[cell] for cell in cells], ignore_index=True)
     return out.reindex(columns=_columns(max_H))
+
+
+def warm_up() -> float:
+    """Compile (or load from the cache) the pruned-tree kernel; returns the seconds it took."""
+    import time
+
+    t0 = time.perf_counter()
+    _pruned_leaves(np.zeros((2, 2)), np.zeros((2, 2)), np.ones((1, 2)), 3)
+    return time.perf_counter() - t0

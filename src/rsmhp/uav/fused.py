@@ -405,24 +405,21 @@ def _kinematics_adjoint(xc, cfg, spd, hdg, inside, gxy, grad):  # pragma: no cov
         grad[2 * j + 1] = bphi * phimax
 
 
-@njit(cache=True, inline="always", error_model="numpy")
+@njit(cache=True, nogil=True, error_model="numpy")
 def _value_grad_scalar(
-    xc, st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad, grad
-):  # pragma: no cover
+    xc, st, cfg, p0, q, sens, tx, ty, wts, uxy, spd, hdg, inside, gxy, mn, det, want_grad, grad
+):  # pragma: no cover - compiled
     """:func:`_value_grad` one hypothesis at a time (each hypothesis' recursion in registers,
     no loop over hypotheses per step): faster below :data:`SOA_MIN_HYPOTHESES` hypotheses,
     where entering the vectorised loops costs more than they save. Same arithmetic and the
     same order of every sum as the vectorised layout, hence the same bits."""
     q = (q[0], q[1], q[2], q[3], q[4], q[5], q[6], q[7], q[8], q[9])
     sens = (sens[0], sens[1], sens[2], sens[3], sens[4], sens[5], sens[6], sens[7])
-    uxy, spd, hdg, inside, gxy = ws[6], ws[7], ws[8], ws[9], ws[10]
     amax, phimax, udt, g, smin, smax, norm, tdt = (
         cfg[0], cfg[1], cfg[2], cfg[3], cfg[4], cfg[5], cfg[6], cfg[7]
     )  # fmt: skip
     horizon, n_t = tx.shape[0], tx.shape[1]
     limited = sens[5] != 0.0
-    mn = ws[11]
-    det = ws[12]
     _kinematics(xc, st, amax, phimax, udt, g, smin, smax, uxy, spd, hdg, inside)
     total = 0.0
     for j in range(horizon):
@@ -555,7 +552,11 @@ def _value_grad(xc, st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad, grad):  # 
     """Cost of ``xc`` (2H,) and, if ``want_grad``, its gradient into ``grad``: the vectorised
     layout from :data:`SOA_MIN_HYPOTHESES` hypotheses on, the scalar one below."""
     if tx.shape[1] < SOA_MIN_HYPOTHESES:
-        return _value_grad_scalar(xc, st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad, grad)
+        # only the arrays it uses: fewer references to count per call
+        return _value_grad_scalar(
+            xc, st, cfg, p0, q, sens, tx, ty, wts,
+            ws[6], ws[7], ws[8], ws[9], ws[10], ws[11], ws[12], want_grad, grad,
+        )  # fmt: skip
     return _value_grad_soa(xc, st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad, grad)
 
 
@@ -752,6 +753,17 @@ def _entries(P: np.ndarray) -> np.ndarray:
     return 0.5 * (P[_ROWS, _COLS] + P[_COLS, _ROWS])
 
 
+def _constant_entries(matrix: bytes) -> np.ndarray:
+    """:func:`_entries` of a 4x4 matrix given by its bytes (the target's Q: the same at every
+    planning step; a fresh writable array, so that the kernels see one array type)."""
+    return np.array(_entries_of_bytes(matrix))
+
+
+@functools.lru_cache(maxsize=64)
+def _entries_of_bytes(matrix: bytes) -> tuple[float, ...]:
+    return tuple(_entries(np.frombuffer(matrix, dtype=float).reshape(4, 4)).tolist())
+
+
 @functools.cache
 def _uav_args(uav: UAVParams) -> tuple[float, ...]:
     """(a_max, phi_max, dt, g, s_min, s_max) of an aircraft (computed once per aircraft)."""
@@ -890,7 +902,7 @@ class Frozen:
             np.ascontiguousarray(uav_state, dtype=float),
             cfg,
             _entries(P0),
-            _entries(Q),
+            _constant_entries(np.asarray(Q, dtype=float).tobytes()),
             _sensor_args(sensor),
             np.ascontiguousarray(txy[:, :, 0].T),
             np.ascontiguousarray(txy[:, :, 1].T),
@@ -982,11 +994,13 @@ def _controls(x: np.ndarray, frozen: Frozen) -> np.ndarray:
 
 
 def warm_up() -> float:
-    """Compile (or load from the cache) every kernel, the planner's and the hypothesis
-    tree's (:func:`rsmhp.uav.target.pruned_tree`); returns the seconds it took."""
+    """Compile (or load from the cache) every kernel of the UAV case study: the planner's
+    (cost, gradient, planning step, path), the hypotheses' (:func:`rsmhp.uav.target.pruned_tree`,
+    the propagation) and the closed-loop step's (:mod:`rsmhp.uav.stepper`); returns the
+    seconds it took."""
     import time
 
-    from rsmhp.uav import target
+    from rsmhp.uav import stepper, target
 
     t0 = time.perf_counter()
     uav = UAVParams(1.0, 9.81, 3.0, 0.7, 10.0, 35.0, 100.0)
@@ -997,9 +1011,17 @@ def warm_up() -> float:
     evaluate(np.zeros((1, 4)), frozen, want_grad=False)
     covariance_traces(eye, np.zeros((1, 2, 2)), txy, 1.0, eye, sensor)
     path(np.zeros(4), frozen)
+    minimise(np.zeros(4), frozen, 1, 2)
+    wide = Frozen(state, uav, eye, np.zeros((SOA_MIN_HYPOTHESES, 2, 2)), 1.0, eye, sensor)
+    evaluate(np.zeros((1, 4)), wide, want_grad=True)  # the same kernels, the other layout
     # the variants run the same compiled code (flags are runtime values), nothing to add
     model = target.TargetModel(1.0, 1.0)
     target.pruned_tree(np.zeros(4), eye, 1, 2, 1, model, np.random.default_rng(0))
+    target.nominal(np.zeros(4), 2, model)
+    step = stepper.Stepper(uav, model, sensor)
+    step.advance(
+        state.copy(), np.ones(4), np.ones(4), eye.copy(), np.zeros(2), np.zeros(4), np.zeros(2), 0.5
+    )
     return time.perf_counter() - t0
 
 
