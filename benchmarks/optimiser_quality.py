@@ -62,7 +62,7 @@ def main() -> None:
     models = {
         "paper": base,
         "footprint150": dataclasses.replace(
-            base, sensor=SensorModel.from_config({"sensor": variant})
+            base, sensor=SensorModel.from_config({**cfg["uav"], "sensor": variant})
         ),
     }
     planners = methods.from_config({"nbo": True, "rsmhp_nt": [50]})

@@ -17,8 +17,7 @@ Parts:
   time of ``simulate_run``, median of runs 1..3) and per planning step (the run's planner
   time / steps);
 * ``rules``: wall time of the two slowest simulation rules' work with the full config:
-  ``decisions_lqg`` (2 workers, as the rule's threads) and one UAV decision-map cell (1
-  thread, as the rule).
+  ``decisions_lqg`` and one UAV decision-map cell (1 thread each, as the rules declare).
 
 The full replication's wall time is measured with ``make replicate`` (``time``), see the
 README; it is not repeated here because one run of the reference takes 15 minutes.
@@ -104,9 +103,9 @@ part = sys.argv[2]
 if part == "decisions_lqg":
     from rsmhp.experiments.decisions_lqg import run_lqg_regret
     small = dict(cfg["decisions"]["lqg"], replicates=2)
-    run_lqg_regret(small, cfg["lqg"]["model"], cfg["seed"], n_jobs=2)  # warm-up
+    run_lqg_regret(small, cfg["lqg"]["model"], cfg["seed"], n_jobs=1)  # warm-up
     t0 = time.perf_counter()
-    run_lqg_regret(cfg["decisions"]["lqg"], cfg["lqg"]["model"], cfg["seed"], n_jobs=2)
+    run_lqg_regret(cfg["decisions"]["lqg"], cfg["lqg"]["model"], cfg["seed"], n_jobs=1)
     out = time.perf_counter() - t0
 else:
     from rsmhp.experiments.decisions_uav import run_map_cell
@@ -194,7 +193,7 @@ def main() -> None:
         parts = [p for p in ("decisions_lqg", "cell") if p in args.rules]
         for part in (args.cell if p == "cell" else p for p in parts):
             ours, base = _pair(args.baseline, RULES, part)
-            label = "decisions_lqg (2 workers)" if part == "decisions_lqg" else f"map cell {part}"
+            label = "decisions_lqg (1 worker)" if part == "decisions_lqg" else f"map cell {part}"
             print(_line(label, ours, base, "s", "{:.1f}"), flush=True)
 
 

@@ -3,22 +3,26 @@ from rsmhp.code_digest import code_digest as _code_digest
 
 THREADS = config["threads"]
 
-# Scheduling: among ready jobs Snakemake starts the one of highest priority. The long jobs,
-# and the chains that end in the report, go first, so that the short ones fill the cores at
-# the end instead of a long job starting last and running alone (measured job times of the
-# default config, 2 cores: estimator ablation 43 s on 2 threads, then its summary 14 s and
-# figures 8 s; decision study (UAV) 35 s on 2 threads; LQG summary 18 s after its three
-# simulations; decision study (LQG) 16 s on 2 threads; map cells and UAV runs 1-9 s each).
+# Scheduling: Snakemake starts the set of ready jobs that fits in the free cores with the
+# largest sum of priorities, and never holds a core back for a job that needs two. So the two
+# jobs that use both cores (threads: THREADS; on 2 cores 1.6x faster than on one) get
+# priorities above any two one-core jobs together and run first, back to back, before a
+# one-core job can hold a core; then the one-core jobs on the chains to the report, and the
+# many short simulation jobs (map cells, UAV runs: 1-9 s) fill both cores to the end. Jobs
+# that gained little from a second worker (LQG convergence 1.34x, NBO error 1.03x, decision
+# study LQG 1.16x, estimator figures 1.06x: pool start-up and serial parts) declare one
+# thread, so they no longer wait for both cores (measured with the default config, -j1 and
+# -j2 runs of one machine).
 PRIORITY = {
-    "estimators_ablation": 50,
-    "estimators_summary": 45,
-    "decisions_uav": 40,
-    "lqg_convergence": 35,
-    "lqg_nbo_error": 35,
-    "lqg_linear_cost": 35,
-    "lqg_summary": 30,
-    "decisions_lqg": 25,
-    "estimators_figures": 20,
+    "estimators_ablation": 1000,
+    "decisions_uav": 990,
+    "estimators_summary": 100,
+    "lqg_convergence": 100,
+    "lqg_nbo_error": 100,
+    "lqg_linear_cost": 100,
+    "decisions_lqg": 100,
+    "lqg_summary": 90,
+    "estimators_figures": 80,
     "decisions_map_cell": 10,
     "uav_simulate": 10,
 }

@@ -34,7 +34,7 @@ rule decisions_lqg:
     priority: PRIORITY["decisions_lqg"]
     conda:
         ENV
-    threads: THREADS
+    threads: 1
     resources:
         mem_mb=2000,
         runtime=30,

@@ -101,7 +101,7 @@ rule estimators_figures:
     priority: PRIORITY["estimators_figures"]
     conda:
         ENV
-    threads: THREADS
+    threads: 1
     resources:
         mem_mb=2000,
         runtime=10,

@@ -26,7 +26,7 @@ rule lqg_convergence:
     priority: PRIORITY["lqg_convergence"]
     conda:
         ENV
-    threads: THREADS
+    threads: 1
     resources:
         mem_mb=2000,
         runtime=20,
@@ -53,7 +53,7 @@ rule lqg_nbo_error:
     priority: PRIORITY["lqg_nbo_error"]
     conda:
         ENV
-    threads: THREADS
+    threads: 1
     resources:
         mem_mb=2000,
         runtime=20,

@@ -22,6 +22,12 @@ from rsmhp.uav.methods.pruned_tree import PrunedTree
 
 __all__ = ["FIGURES", "uav_section", "uav_tables"]
 
+#: how the appendix names the planner's optimiser (config ``uav.planner.optimiser``)
+OPTIMISER_TEXT = {
+    "boxqn": "a projected L-BFGS (`rsmhp.boxqn`, compiled, scipy's tolerances)",
+    "scipy": "scipy's L-BFGS-B",
+}
+
 #: figure stems written by the figure rule and referenced by the report section, in the order
 #: of the section: each paper-style CDF is followed by its paired view
 FIGURES = ("uav_error_cdf_nt", "uav_paired_diff_nt", "uav_error_cdf_nbo", "uav_paired_diff")
@@ -250,7 +256,8 @@ def _appendix(setting: Mapping[str, Any], tables: Mapping[str, str]) -> str:
         f"SD σ_c = {_num(setting['sensor']['sigma_c_per_m'])} d (d: 3-D UAV–target "
         f"distance); Kalman filter with P0 = diag({sp}², {sp}², {sv}², {sv}²). Planner: "
         f"horizon H = {pl['horizon']}, cost Σ_{{k=1..H}} tr P_k (P_k: 4×4 covariance "
-        "predicted along a target hypothesis) averaged over the hypotheses, L-BFGS-B on "
+        "predicted along a target hypothesis) averaged over the hypotheses, "
+        f"{OPTIMISER_TEXT[pl.get('optimiser', 'boxqn')]} on "
         f"the control box with at most {pl['maxiter']} iterations / {pl['maxfun']} "
         "evaluations, exact gradient, warm start from the shifted previous plan; identical "
         "for every method." + _variant_note(setting["sensor"])
