@@ -50,10 +50,18 @@ s'\Delta t (\cos\psi', \sin\psi')`): back-substitution of these three lines. At 
 speed derivative is taken as 0 when :math:`s + a\Delta t` lies on or outside the speed
 bounds (a one-sided derivative; the clip has a kink there).
 
-Compilation: numba ``njit`` with ``cache=True``; the first call on a machine compiles (a few
-seconds) and writes the cache beside this file, or in numba's user-wide cache directory when
-the install is read-only (or in ``NUMBA_CACHE_DIR`` when set); later processes load it.
-Single-threaded: parallelism is across closed-loop runs (joblib), never inside the kernel.
+Layout: the recursion runs over the hypotheses in structure-of-arrays form (hypotheses
+innermost, one loop per step and stage), which LLVM vectorises; below
+:data:`SOA_MIN_HYPOTHESES` hypotheses one hypothesis at a time is faster. Both layouts do the
+same IEEE operations per hypothesis and sum over hypotheses in the same order (no fastmath),
+so they give the same bits. :func:`minimise` runs a whole planning step
+(:func:`rsmhp.boxqn.minimise` on this cost) in one compiled call.
+
+Compilation: numba ``njit`` with ``cache=True``; the first call on a machine compiles (about
+a minute for every kernel, :func:`warm_up`) and writes the cache beside this file, or in
+numba's user-wide cache directory when the install is read-only (or in ``NUMBA_CACHE_DIR``
+when set); later processes load it. Single-threaded: parallelism is across closed-loop runs
+(joblib), never inside the kernel.
 """
 
 from __future__ import annotations

@@ -198,8 +198,9 @@ def simulate_run(
     the loop only calls its :meth:`~rsmhp.uav.methods.Method.planner`): (summary row, per-step
     rows).
 
-    BLAS is limited to one thread for the run: the planner's small dense algebra (scipy's
-    L-BFGS-B on 2H variables) is many times slower with a multi-threaded BLAS pool.
+    BLAS is limited to one thread for the run: small dense algebra (the hypothesis draws; with
+    ``optimiser: scipy``, L-BFGS-B on 2H variables) is many times slower with a
+    multi-threaded BLAS pool.
 
     The arguments are checked here, once per run (``setup`` and ``method`` were checked when
     they were built); the steps of the run then call the planner, the hypothesis generators
