@@ -77,6 +77,17 @@ def _proj_grad_norm(x, g):  # pragma: no cover - compiled
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
+def _trial(x, d, a, g, out):  # pragma: no cover - compiled
+    """The projected trial point P(x + a d) into ``out``; returns g^T (out - x), the
+    first-order decrease of the Armijo test."""
+    decrease = 0.0
+    for i in range(x.size):
+        out[i] = min(max(x[i] + a * d[i], -1.0), 1.0)
+        decrease += g[i] * (out[i] - x[i])
+    return decrease
+
+
+@njit(cache=True, nogil=True, error_model="numpy")
 def _max_step(x, d):  # pragma: no cover - compiled
     """The largest alpha with x + alpha d in the box (inf if d = 0)."""
     out = np.inf
@@ -204,10 +215,7 @@ def minimise(fg, data, x0, maxiter, maxfun, m, pgtol, ftol, x_out):  # pragma: n
         accepted = False
         ft = f
         for _ in range(MAX_BACKTRACK):
-            decrease = 0.0
-            for i in range(n):
-                xt[i] = min(max(x[i] + a * d[i], -1.0), 1.0)
-                decrease += g[i] * (xt[i] - x[i])
+            decrease = _trial(x, d, a, g, xt)
             ft = fg(xt, gt, data)
             nfev += 1
             if ft <= f + C1 * decrease:
@@ -230,10 +238,7 @@ def minimise(fg, data, x0, maxiter, maxfun, m, pgtol, ftol, x_out):  # pragma: n
                 if slope >= CURVATURE * gd:
                     break
                 a2 = min(4.0 * a, a_max)
-                decrease = 0.0
-                for i in range(n):
-                    x2[i] = min(max(x[i] + a2 * d[i], -1.0), 1.0)
-                    decrease += g[i] * (x2[i] - x[i])
+                decrease = _trial(x, d, a2, g, x2)
                 f2 = fg(x2, g2, data)
                 nfev += 1
                 if not (f2 < ft and f2 <= f + C1 * decrease):

@@ -18,7 +18,7 @@ from rsmhp.contracts import Contract
 from rsmhp.parallel import chunked, parallel_map
 from rsmhp.uav import methods
 from rsmhp.uav.methods import Method
-from rsmhp.uav.simulation import UAVSetup, simulate_run
+from rsmhp.uav.simulation import STEP_VALUES, UAVSetup, simulate_run
 
 __all__ = [
     "NONDETERMINISTIC_COLUMNS",
@@ -48,28 +48,7 @@ RUN_COLUMNS = [
     "mean_nit",
     "plan_seconds",
 ]
-STEP_COLUMNS = [
-    "method",
-    "N_T",
-    "run",
-    "step",
-    "error",
-    "trace",
-    "uav_x",
-    "uav_y",
-    "uav_speed",
-    "uav_heading",
-    "target_x",
-    "target_y",
-    "est_x",
-    "est_y",
-    "accel",
-    "bank",
-    "plan_cost",
-    "plan_cost_warm",
-    "nit",
-    "kernel_calls",
-]
+STEP_COLUMNS = ["method", "N_T", "run", "step", *STEP_VALUES, "nit", "kernel_calls"]
 #: config keys of the ``uav`` section a simulation depends on (besides its method and the seed)
 UAV_MODEL_KEYS = ("dt", "g", "aircraft", "target", "sensor", "tracker", "scenario", "planner")
 #: wall-time columns: excluded from every determinism check

@@ -66,6 +66,7 @@ from rsmhp.uav.stepper import Stepper
 from rsmhp.uav.target import TargetModel
 
 __all__ = [
+    "STEP_VALUES",
     "Scenario",
     "StepInfo",
     "UAVSetup",
@@ -223,7 +224,8 @@ def _blas() -> ThreadpoolController:
     return ThreadpoolController()
 
 
-_ROW_KEYS = (
+#: the float columns of a step row, in table order (``rsmhp.experiments.uav.STEP_COLUMNS``)
+STEP_VALUES = (
     "error",
     "trace",
     "uav_x",
@@ -253,7 +255,7 @@ def _simulate_run(setup, method, seed, run, observer):
     x_est, P_est = sc.estimate.astype(float), np.array(setup.P0, dtype=float)
     stepper = Stepper(setup.uav, setup.target, setup.sensor)
     warm = np.zeros((H, 2))
-    vals = np.empty((K, len(_ROW_KEYS)))  # one row of floats per step, dicts built at the end
+    vals = np.empty((K, len(STEP_VALUES)))  # one row of floats per step, dicts built at the end
     counts = np.empty((K, 2), dtype=np.int64)  # nit, kernel calls
     seen_k = np.ones(K, dtype=bool)
     plan_seconds = 0.0
@@ -285,7 +287,7 @@ def _simulate_run(setup, method, seed, run, observer):
             )  # fmt: skip
     rows: list[dict[str, Any]] = []
     for k in range(K):
-        row = {"step": k + 1, **dict(zip(_ROW_KEYS, vals[k].tolist(), strict=True))}
+        row = {"step": k + 1, **dict(zip(STEP_VALUES, vals[k].tolist(), strict=True))}
         row["nit"], row["kernel_calls"] = int(counts[k, 0]), int(counts[k, 1])
         if limited:  # variant-only column: the paper's model's outputs stay as they were
             row["detected"] = bool(seen_k[k])

@@ -37,6 +37,19 @@ from rsmhp.uav.target import TargetModel
 __all__ = ["Stepper"]
 
 
+@njit(cache=True, inline="always", error_model="numpy")
+def _geometry(uav, target, h2):  # pragma: no cover - compiled
+    """(d^2, cos beta, sin beta) from the UAV to ``target`` (rsmhp.uav.sensor._geometry:
+    bearing 0 directly overhead)."""
+    dx = target[0] - uav[0]
+    dy = target[1] - uav[1]
+    rho2 = dx * dx + dy * dy
+    rho = np.sqrt(rho2)
+    c = dx / rho if rho != 0.0 else 1.0
+    s = dy / rho if rho != 0.0 else 0.0
+    return rho2 + h2, c, s
+
+
 @njit(cache=True, nogil=True, error_model="numpy")
 def _advance(uav, x_true, x_est, P, control, w, zeta, det_u, F, Q, ucfg, sens):  # pragma: no cover
     """In place on ``uav`` (4,), ``x_true`` (4,), ``x_est`` (4,), ``P`` (4, 4); returns
@@ -80,13 +93,7 @@ def _advance(uav, x_true, x_est, P, control, w, zeta, det_u, F, Q, ucfg, sens): 
     if seen:
         fr2, fc2, h2 = sens[0] * sens[0], sens[1] * sens[1], sens[2] * sens[2]
         # R at the predicted estimate (rsmhp.uav.sensor._measurement_cov_entries)
-        dx = x_est[0] - uav[0]
-        dy = x_est[1] - uav[1]
-        rho2 = dx * dx + dy * dy
-        rho = np.sqrt(rho2)
-        c = dx / rho if rho != 0.0 else 1.0
-        s = dy / rho if rho != 0.0 else 0.0
-        d2 = rho2 + h2
+        d2, c, s = _geometry(uav, x_est, h2)
         if sens[3] != 0.0:
             d2 = d2 * d2 / (sens[4] * sens[4])
         R = np.empty((2, 2))
@@ -95,13 +102,7 @@ def _advance(uav, x_true, x_est, P, control, w, zeta, det_u, F, Q, ucfg, sens): 
         R[1, 0] = R[0, 1]
         R[1, 1] = d2 * (fr2 * s * s + fc2 * c * c)
         # noise in the true geometry (rsmhp.uav.sensor.measurement_noise)
-        dx = x_true[0] - uav[0]
-        dy = x_true[1] - uav[1]
-        rho2 = dx * dx + dy * dy
-        rho = np.sqrt(rho2)
-        c = dx / rho if rho != 0.0 else 1.0
-        s = dy / rho if rho != 0.0 else 0.0
-        d2 = rho2 + h2
+        d2, c, s = _geometry(uav, x_true, h2)
         d = d2 / sens[4] if sens[3] != 0.0 else np.sqrt(d2)
         zr = zeta[0] * (sens[0] * d)
         zc = zeta[1] * (sens[1] * d)
