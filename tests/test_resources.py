@@ -74,6 +74,7 @@ def test_the_issue_example_is_refused_naming_the_keys():
     declared = {"lqg_nbo_error": 2000, "lqg_convergence": 2000, "estimators_ablation": 3000}
     assert memory_problems(cfg, declared) == []  # the full replication fits
     cfg["lqg"]["nbo_error"].update(P=10_000_000, H_values=[200])
+    cfg["threads"] = 2  # the estimate is per worker (an upper bound for a one-thread rule)
     (msg,) = memory_problems(cfg, declared)
     assert msg.startswith("lqg_nbo_error: needs about ")
     assert "mem_mb = 2000" in msg and "lqg.nbo_error.P, lqg.nbo_error.H_values" in msg
