@@ -84,6 +84,36 @@ def test_score_state_rows():
     assert again == rows  # seeded by (model, run, step, method), not by call order
 
 
+def test_every_family_is_scored_open_loop():
+    """The point-set planners and the tree search go through the same scoring; the tree
+    search has no cost of an arbitrary plan, so its rank columns are NaN."""
+    setup = UAVSetup.from_config(_short())
+    state = belief_states(setup, "paper", 5, [0], [3])[0]
+    block = {
+        "nbo": True,
+        "rqmc_nt": [16],
+        "antithetic_nt": [16],
+        "sigma": True,
+        "dpw": [{"sims": 50}],
+    }
+    methods = uav_methods.from_config(block)
+    rows = score_state(state, setup, methods, SCORING, 5)
+    assert [r["method"] for r in rows] == [
+        "nbo",
+        "rqmc_nt16",
+        "antithetic_nt16",
+        "sigma",
+        "dpw_s50",
+    ]
+    for r in rows:
+        assert set(r) == set(REGRET_COLUMNS)
+        assert r["regret"] >= -1e-9 * r["best_cost"] and np.isfinite(r["eval_cost"])
+        if r["family"] == "dpw":
+            assert np.isnan(r["spearman_random"]) and np.isnan(r["spearman_local"])
+        else:
+            assert -1 <= r["spearman_random"] <= 1
+
+
 def test_a_certain_belief_makes_every_method_plan_alike():
     """With a nearly exact belief and almost no target noise every hypothesis is the nominal
     one: RS-MHP's and the tree's costs equal NBO's to within that spread."""

@@ -115,7 +115,15 @@ def _all_blocks():
 
 
 def test_families_and_the_published_job_keys():
-    assert [c.family for c in methods.families()] == ["nbo", "rsmhp", "tree"]
+    assert [c.family for c in methods.families()] == [
+        "nbo",
+        "rsmhp",
+        "tree",
+        "rqmc",
+        "antithetic",
+        "sigma",
+        "dpw",
+    ]
     assert methods.baseline().family == "nbo"
     got = methods.from_config(CONFIG["uav"]["methods"], "uav.methods")
     assert list(got) == ["nbo", "rsmhp_nt50", "rsmhp_nt100", "rsmhp_nt250", "tree_n8_m100"]

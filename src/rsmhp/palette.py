@@ -27,6 +27,7 @@ __all__ = [
     "method_label",
     "method_rgb",
     "register_resolver",
+    "size_shade",
 ]
 
 #: seaborn "colorblind" palette, in its order (C0..C9)
@@ -60,6 +61,23 @@ METHOD_COLOURS: dict[str, str] = {
 
 #: line style by role: a measured curve, a derived (closed-form) curve, a weighted variant
 LINESTYLES = {"measured": "-", "derived": "--", "weighted": ":"}
+
+
+#: mixing weights of :func:`size_shade` (towards white > 0, towards black < 0), small to large
+_SIZE_MIX = (0.45, 0.25, 0.0, -0.25, -0.45)
+
+
+def size_shade(colour: str, n: int, edges: tuple[int, ...] = (16, 32, 64, 128)) -> str:
+    """A shade of the hex ``colour`` for a member of size ``n`` (hypotheses): lighter below
+    the middle edge, darker above it, five levels split at ``edges`` (4 increasing values)."""
+    if len(edges) != len(_SIZE_MIX) - 1:
+        raise ValueError(f"edges must hold {len(_SIZE_MIX) - 1} values, got {edges!r}")
+    mix = _SIZE_MIX[sum(n > e for e in edges)]
+    h = colour.lstrip("#")
+    rgb = [int(h[i : i + 2], 16) for i in (0, 2, 4)]
+    target = 255 if mix > 0 else 0
+    out = [round(c + abs(mix) * (target - c)) for c in rgb]
+    return "#" + "".join(f"{c:02x}" for c in out)
 
 
 def method_colour(method: str) -> str:

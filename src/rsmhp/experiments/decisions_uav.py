@@ -258,16 +258,21 @@ def score_state(
     )[..., :2]
     args = (setup.uav, setup.target, setup.sensor, setup.planner)
     ev = PlanningProblem(state.uav, state.P_hat, eval_xy, *args)
-    plans: dict[str, tuple[np.ndarray, float, PlanningProblem]] = {}
+    plans: dict[str, tuple[np.ndarray, float, PlanningProblem | None]] = {}
     belief = Belief(state.uav, state.x_hat, state.P_hat)
     scale = np.tile(setup.uav.control_scale, H)
     for name, method in planners.items():
         rng = job_rng(seed, "decisions_uav_plan", **ident, **method.job_key())
         res = method.planner(setup).plan(belief, state.warm, rng)
-        # the method's own cost of any plan (rank agreement); NaN-free only with hypotheses
+        # the method's own cost of any plan (rank agreement); a planner without hypotheses
+        # (a tree search) has no cost of an arbitrary plan: its rank columns are NaN
         hyp = res.hypotheses
-        prob = PlanningProblem(
-            state.uav, state.P_hat, hyp.states[..., :2], *args, weights=hyp.weights
+        prob = (
+            None
+            if hyp is None
+            else PlanningProblem(
+                state.uav, state.P_hat, hyp.states[..., :2], *args, weights=hyp.weights
+            )
         )
         plans[name] = (res.controls.ravel() / scale, res.cost, prob)
     # reference: multi-start optimisation of the evaluation cost
@@ -313,12 +318,15 @@ def score_state(
                 "regret_se": float(diff.std(ddof=1) / np.sqrt(n_eval)),
                 "regret_rel": float(diff.mean() / best_cost),
                 "regret_methods": float(per_hyp[k].mean() - best_method_cost),
-                "spearman_random": _spearman(prob.costs(rand), ev_rand),
-                "spearman_local": _spearman(prob.costs(local), ev_local),
+                "spearman_random": _spearman(prob.costs(rand), ev_rand) if prob else NAN,
+                "spearman_local": _spearman(prob.costs(local), ev_local) if prob else NAN,
                 "n_eval": n_eval,
             }
         )
     return rows
+
+
+NAN = float("nan")
 
 
 def _spearman(a: np.ndarray, b: np.ndarray) -> float:

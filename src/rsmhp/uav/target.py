@@ -48,6 +48,7 @@ __all__ = [
     "HypothesisNoise",
     "TargetModel",
     "draw_independent",
+    "from_normals",
     "nominal",
     "process_noise",
     "pruned_tree",
@@ -238,6 +239,36 @@ def draw_independent(
     x0 = np.asarray(x_hat, dtype=float) + dev
     # one (n H, 4) x (4, 4) product (a batched (n, H, 4) product is n small ones: 10x slower)
     w = (rng.standard_normal((n * horizon, 4)) @ model.noise.chol.T).reshape(n, horizon, 4)
+    return _propagate(x0, w, model.F), np.concatenate([dev[:, None, :], w], axis=1)
+
+
+def from_normals(
+    x_hat: np.ndarray,
+    P_hat: np.ndarray,
+    z: np.ndarray,
+    model: TargetModel,
+    *,
+    check: bool = True,
+) -> tuple[np.ndarray, np.ndarray]:
+    r"""Hypotheses from standard-normal coordinates ``z`` (n, H + 1, 4), for point sets other
+    than i.i.d. draws (quasi-Monte Carlo, antithetic pairs, sigma points): the initial
+    deviation :math:`x_0 - \hat x = L_P z_0` with :math:`L_P L_P^\top = \hat P`, the process
+    noise :math:`w_j = L_Q z_j` with :math:`L_Q L_Q^\top = Q`, and :math:`x_j = F x_{j-1} +
+    w_j`. Returns ``(states (n, H, 4), noise (n, H + 1, 4))`` as :func:`draw_independent`
+    does; ``z`` drawn i.i.d. standard normal gives hypotheses with exactly its distribution.
+    A point set whose weighted mean is 0 and weighted second moment the identity gives
+    hypotheses whose weighted mean and covariance are those of the belief's (the map is
+    linear)."""
+    z = np.asarray(z, dtype=float)
+    if check:
+        if z.ndim != 3 or z.shape[0] == 0 or z.shape[1] < 2 or z.shape[2] != 4:
+            raise ValueError(f"z must have shape (n, H + 1, 4) with n, H >= 1, got {z.shape}")
+        _check_estimate(x_hat, P_hat, z.shape[1] - 1, model)
+        guards.finite_array("z", z)
+    n, h1 = z.shape[0], z.shape[1]
+    dev = z[:, 0] @ _chol(P_hat).T
+    x0 = np.asarray(x_hat, dtype=float) + dev
+    w = (z[:, 1:].reshape(n * (h1 - 1), 4) @ model.noise.chol.T).reshape(n, h1 - 1, 4)
     return _propagate(x0, w, model.F), np.concatenate([dev[:, None, :], w], axis=1)
 
 
