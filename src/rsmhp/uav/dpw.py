@@ -42,6 +42,8 @@ import math
 import numpy as np
 from numba import njit
 
+from rsmhp import numba_cache
+from rsmhp.uav import stepper as _stepper
 from rsmhp.uav.stepper import _advance
 
 __all__ = ["search"]
@@ -299,3 +301,8 @@ def search(
         stepper.F, stepper.Q, np.linalg.cholesky(stepper.Q), stepper.ucfg, stepper.sens,
         rng,
     )  # fmt: skip
+
+
+# the compiled search links the closed-loop step of rsmhp.uav.stepper into its cached code:
+# drop that cache when stepper.py changes (numba only watches this file)
+numba_cache.invalidate_if_changed(_search, [_stepper])
