@@ -228,3 +228,43 @@ def test_each_new_method_plans_a_step(name):
     assert res.controls.shape == (H, 2) and (np.abs(res.controls) <= scale * (1 + 1e-12)).all()
     assert np.isfinite(res.cost) and res.cost <= res.cost_warm
     assert res.hypotheses.n == (n_points(H) if name == "sigma" else m.n_traj)
+
+
+# ------------------------------------------------------------------------ Sobol' points
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    d=st.integers(1, 60),
+    m=st.integers(0, 10),
+    extra=st.integers(0, 5),
+    seed=st.integers(0, 2**32 - 1),
+)
+def test_sobol_points_are_scipys_bit_for_bit(d, m, extra, seed):
+    """designs.sobol_points = qmc.Sobol(d, scramble=True, rng).random(n), also for n not a
+    power of 2, and both leave the parent generator in the same state."""
+    import warnings
+
+    from scipy.stats import qmc
+
+    from rsmhp import designs
+
+    n = 2**m + extra
+    r1, r2 = np.random.default_rng(seed), np.random.default_rng(seed)
+    ours = [designs.sobol_points(r1, n, d) for _ in range(2)]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # scipy's balance warning for n not a power of 2
+        theirs = [qmc.Sobol(d, scramble=True, rng=r2).random(n) for _ in range(2)]
+    for a, b in zip(ours, theirs, strict=True):
+        np.testing.assert_array_equal(a, b)
+    assert r1.random() == r2.random()
+
+
+def test_sobol_points_refuse_bad_arguments():
+    from rsmhp import designs
+
+    rng = np.random.default_rng(0)
+    with pytest.raises(ValueError, match=r"d must be at most 21201, got 30000"):
+        designs.sobol_points(rng, 4, 30000)
+    with pytest.raises(ValueError, match=r"n"):
+        designs.sobol_points(rng, 0, 3)

@@ -1,12 +1,13 @@
 r"""RS-MHP with randomised quasi-Monte-Carlo hypotheses: the first ``N_T`` points of a Sobol'
 sequence in :math:`[0, 1)^{4(H+1)}`, scrambled afresh at every planning step from the run's
-random stream (Owen scrambling, :class:`scipy.stats.qmc.Sobol`), mapped to standard normals by
-the quantile :math:`\Phi^{-1}` and then to the initial deviation and the H process noises
-(:func:`rsmhp.uav.target.from_normals`); weights :math:`1/N_T`. Each point is marginally an
-exact draw of the belief's future (the cost estimate is unbiased), while the set fills the
-space more evenly than independent draws. ``N_T`` must be a power of 2 (the Sobol' balance
-property). Config: ``rqmc_nt: [16, 32, 64, 128, 256]``, one method per N_T, named
-``rqmc_nt<N_T>``."""
+random stream (scipy's linear matrix scramble and digital shift, computed by
+:func:`rsmhp.designs.sobol_points` bit for bit as :class:`scipy.stats.qmc.Sobol` does, about
+10x faster), mapped to standard normals by the quantile :math:`\Phi^{-1}` and then to the
+initial deviation and the H process noises (:func:`rsmhp.uav.target.from_normals`); weights
+:math:`1/N_T`. Each point is marginally an exact draw of the belief's future (the cost
+estimate is unbiased), while the set fills the space more evenly than independent draws.
+``N_T`` must be a power of 2 (the Sobol' balance property). Config: ``rqmc_nt: [16, 32, 64,
+128, 256]``, one method per N_T, named ``rqmc_nt<N_T>``."""
 
 from __future__ import annotations
 
