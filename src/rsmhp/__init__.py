@@ -24,6 +24,7 @@ Models
                     gradient, vectorised over hypotheses; the compiled planning step),
                     planner (Planner and Optimiser protocols: boxqn, scipy's L-BFGS-B),
                     methods (registry of planning methods, one module per family),
+                    dpw (compiled tree search with double progressive widening),
                     simulation, recording
 Stages of the pipeline (one module per model and stage)
   experiments       lqg, estimators, uav, decisions_lqg, decisions_uav: config -> tidy tables
