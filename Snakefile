@@ -56,6 +56,7 @@ include: "workflow/rules/lqg.smk"
 include: "workflow/rules/estimators.smk"
 include: "workflow/rules/uav.smk"
 include: "workflow/rules/decisions.smk"
+include: "workflow/rules/frontier.smk"
 include: "workflow/rules/report.smk"
 
 
@@ -76,4 +77,5 @@ rule all:
         rules.estimators.input,
         rules.uav.input,
         rules.decisions.input,
+        rules.frontier.input,
         rules.report.output,

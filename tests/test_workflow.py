@@ -327,6 +327,23 @@ def test_decision_study_outputs(run_j2, tiny, tmp_path):
     ).read_bytes()
 
 
+def test_frontier_outputs(run_j2, tiny):
+    """The equal-compute study runs in the default target: one job per model, every method's
+    paired runs with its planning time, the summary and the figure."""
+    cfg = tiny["decisions"]["frontier"]
+    names = ["nbo", "rsmhp_nt8", "rqmc_nt8", "sigma", "dpw_s20"]
+    for model in cfg["models"]:
+        runs = pd.read_csv(run_j2 / f"results/decisions/frontier/{model}.csv")
+        assert list(dict.fromkeys(runs["method"])) == names
+        assert len(runs) == len(names) * cfg["runs"] and (runs["plan_ms"] > 0).all()
+        assert (run_j2 / f"results/benchmarks/decisions_frontier/{model}.tsv").exists()
+    summary = pd.read_csv(run_j2 / "results/decisions/frontier_summary.csv")
+    assert len(summary) == len(names) * len(cfg["models"])
+    assert (summary.loc[summary["method"] == "nbo", "error_diff"] == 0).all()
+    png = (run_j2 / "results/figures/dec_frontier.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+
+
 def test_uav_decision_outputs(run_j2, tiny):
     cfg = tiny["decisions"]
     regret = pd.read_csv(run_j2 / "results/decisions/uav_regret.csv")

@@ -259,13 +259,15 @@ def _nothing_to_run(config: Mapping[str, Any]) -> list[str]:
 
 def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
     """Belief-state steps inside a run, map axes with values their key allows, a method to
-    compare, unique model names."""
+    compare, unique model names, frontier models that are decision-study models."""
     problems: list[str] = []
     dec = config.get("decisions", {}) or {}
     n_steps = ((config.get("uav", {}) or {}).get("scenario", {}) or {}).get("steps", 60)
+    fr = dec.get("frontier", {}) or {}
     for path, steps in (
         ("decisions.uav.steps", (dec.get("uav", {}) or {}).get("steps", [])),
         ("decisions.map.regret_steps", (dec.get("map", {}) or {}).get("regret_steps", [])),
+        ("decisions.frontier.regret_steps", fr.get("regret_steps", [])),
     ):
         late = [s for s in steps or [] if isinstance(s, int) and s >= n_steps]
         if late:
@@ -278,7 +280,7 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
     if dup:
         problems.append(f"decisions.uav.models: duplicate name(s) {dup} (allowed: unique names)")
     base = uav_methods.baseline()
-    for section in ("uav", "map"):
+    for section in ("uav", "map", "frontier"):
         methods = (dec.get(section, {}) or {}).get("methods")
         if isinstance(methods, Mapping) and methods:
             n = uav_methods.count(methods)
@@ -299,6 +301,12 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
             problems += uav_methods.config_problems(
                 methods, f"decisions.{section}.methods", config.get("uav", {}) or {}
             )
+    unknown = [m for m in fr.get("models", []) or [] if names and m not in names]
+    if unknown:
+        problems.append(
+            f"decisions.frontier.models: {unknown} not model(s) of decisions.uav.models "
+            f"(allowed: {', '.join(map(str, names))})"
+        )
     rec = (dec.get("recording", {}) or {}).get("model")
     if rec is not None and names and rec not in names:
         problems.append(

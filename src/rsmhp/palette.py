@@ -56,6 +56,7 @@ METHOD_COLOURS: dict[str, str] = {
     "sobol": _CB[5],
     "cubature": _CB[6],
     "gauss_hermite": _CB[7],
+    "dpw": _CB[8],
     "exact": "#000000",
 }
 
@@ -139,6 +140,7 @@ def method_label(method: str) -> str:
         "sobol": "Sobol' (scrambled)",
         "cubature": "cubature",
         "gauss_hermite": "Gauss-Hermite",
+        "dpw": "tree search",
         "exact": "exact",
     }
     if name in labels:

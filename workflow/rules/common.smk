@@ -4,18 +4,18 @@ from rsmhp.code_digest import code_digest as _code_digest
 THREADS = config["threads"]
 
 # Scheduling: Snakemake starts the set of ready jobs that fits in the free cores with the
-# largest sum of priorities, and never holds a core back for a job that needs two. So the two
-# jobs that use both cores (threads: THREADS; on 2 cores 1.6x faster than on one) get
-# priorities above any two one-core jobs together and run first, back to back, before a
-# one-core job can hold a core; then the one-core jobs on the chains to the report, and the
-# many short simulation jobs (map cells, UAV runs: 1-9 s) fill both cores to the end. Jobs
-# that gained little from a second worker (LQG convergence 1.34x, NBO error 1.03x, decision
-# study LQG 1.16x, estimator figures 1.06x: pool start-up and serial parts) declare one
-# thread, so they no longer wait for both cores (measured with the default config, -j1 and
-# -j2 runs of one machine).
+# largest sum of priorities. The longest jobs (estimator ablation, UAV decision study: threads
+# from the config, 1 by default; then the equal-compute study, one job per model) get
+# priorities above any two shorter jobs together and start first, one per core; then the
+# one-core jobs on the chains to the report, and the many short simulation jobs (map cells,
+# UAV runs: 1-9 s) fill both cores to the end. Jobs that gained little from a second worker
+# (LQG convergence 1.34x, NBO error 1.03x, decision study LQG 1.16x, estimator figures 1.06x:
+# pool start-up and serial parts) declare one thread (measured with the default config, -j1
+# and -j2 runs of one machine).
 PRIORITY = {
     "estimators_ablation": 1000,
     "decisions_uav": 990,
+    "decisions_frontier": 980,
     "estimators_summary": 100,
     "lqg_convergence": 100,
     "lqg_nbo_error": 100,

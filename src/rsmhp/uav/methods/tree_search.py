@@ -107,7 +107,7 @@ class TreeSearch(Method):
     }
     default: ClassVar[Any] = []
     family_label: ClassVar[str] = "tree search"
-    colour: ClassVar[str] = METHOD_COLOURS["tree_pernode"]
+    colour: ClassVar[str] = METHOD_COLOURS["dpw"]
     order: ClassVar[int] = 6
     name_pattern: ClassVar[str] = r"dpw_s(\d+)"
     #: the tables' N_T: 0 (no fixed hypotheses; ``sims`` is the budget)

@@ -1,0 +1,72 @@
+r"""The planner frontier: decision quality against planning compute, one curve per family.
+
+Columns: model variants. Top row: open-loop relative regret minus NBO's at the same belief
+states (percentage points); bottom row: closed-loop mean location error minus NBO's on the same
+runs (m). x: planning milliseconds per step (median over runs, log scale). Each family is one
+line through its members in order of compute, in the palette's family colour, with the 95%
+bootstrap CI of every point as a vertical bar; NBO is the reference line at 0.
+"""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+
+from rsmhp.figures import theme
+from rsmhp.palette import method_colour
+from rsmhp.uav import methods
+
+__all__ = ["FIGURES", "frontier_figure"]
+
+FIGURES = ["dec_frontier"]
+
+_ROWS = (
+    ("regret_diff_pp", "open-loop regret − NBO's (pp)"),
+    ("error_diff", "closed-loop mean error − NBO's (m)"),
+)
+
+
+def frontier_figure(summary: pd.DataFrame) -> plt.Figure:
+    """The frontier of ``summary`` (:func:`rsmhp.analysis.frontier.summarize_frontier`)."""
+    theme()
+    models = list(dict.fromkeys(summary["model"]))
+    if not models:
+        raise ValueError("frontier summary is empty")
+    fams = {c.family: c for c in methods.families()}
+    fig, axes = plt.subplots(
+        2, len(models), figsize=(4.6 * len(models), 7.0), squeeze=False, sharex=True
+    )
+    for j, model in enumerate(models):
+        s = summary[summary["model"] == model]
+        for i, (col, label) in enumerate(_ROWS):
+            ax = axes[i, j]
+            ax.axhline(0.0, color=method_colour("nbo"), lw=1.2, ls="--", label="NBO")
+            for fam, g in s.groupby("family", sort=False):
+                if fams[fam].baseline:
+                    continue
+                g = g.sort_values("plan_ms")
+                y = g[col].to_numpy(float)
+                lo = y - g[f"{col}_low"].to_numpy(float)
+                hi = g[f"{col}_high"].to_numpy(float) - y
+                ax.errorbar(
+                    g["plan_ms"],
+                    y,
+                    yerr=np.vstack([lo, hi]),
+                    color=fams[fam].colour,
+                    marker="o",
+                    ms=4,
+                    capsize=2,
+                    lw=1.4,
+                    label=fams[fam].family_label,
+                )
+            ax.set_xscale("log")
+            if i == 0:
+                ax.set_title(model)
+            if i == 1:
+                ax.set_xlabel("planning ms per step (median over runs)")
+            if j == 0:
+                ax.set_ylabel(label)
+    axes[0, -1].legend(fontsize="small", loc="best")
+    fig.tight_layout()
+    return fig

@@ -1,0 +1,14 @@
+"""Rule decisions_frontier: the equal-compute study of one model variant (closed and open
+loop, planning time per step)."""
+
+from rsmhp.experiments.frontier import run_frontier_model
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake):
+    p = snakemake.params
+    runs, regret = run_frontier_model(
+        p.uav, p.models, p.cfg, p.scoring, snakemake.wildcards.model, p.seed
+    )
+    write_csv(runs, snakemake.output.runs)
+    write_csv(regret, snakemake.output.regret)

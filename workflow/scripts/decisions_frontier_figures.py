@@ -1,0 +1,14 @@
+"""Rule decisions_frontier_figures: the planner frontier (PNG + PDF)."""
+
+from pathlib import Path
+
+from rsmhp.analysis.frontier import FRONTIER_SUMMARY_COLUMNS
+from rsmhp.figures import save_figure
+from rsmhp.figures.frontier import frontier_figure
+from rsmhp.io import read_table
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake):
+    outdir = Path(snakemake.output[0]).parent
+    summary = read_table(snakemake.input.summary, FRONTIER_SUMMARY_COLUMNS)
+    save_figure(frontier_figure(summary), outdir / "dec_frontier")
