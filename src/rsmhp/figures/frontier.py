@@ -12,6 +12,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 from rsmhp.figures import theme
 from rsmhp.palette import method_colour
@@ -61,6 +62,10 @@ def frontier_figure(summary: pd.DataFrame) -> plt.Figure:
                     label=fams[fam].family_label,
                 )
             ax.set_xscale("log")
+            # plain numbers on the decades and 2, 5 between them; no crowded minor labels
+            ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.xaxis.set_minor_formatter(NullFormatter())
             if i == 0:
                 ax.set_title(model)
             if i == 1:
