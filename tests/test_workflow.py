@@ -422,8 +422,8 @@ def test_slurm_profile_plans_every_rule(tmp_path):
         for line in out.splitlines()
         if line.startswith(("rule ", "localrule "))
     }
-    # the default target plans every rule except the four study-level target rules and verify
-    assert planned == every - {"lqg", "estimators", "uav", "decisions", "verify"}
+    # the default target plans every rule except the five study-level target rules and verify
+    assert planned == every - {"lqg", "estimators", "uav", "decisions", "frontier", "verify"}
     profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
     assert profile["executor"] == "slurm"
     block = out.split("rule estimators_ablation:", 1)[1].split("\n\n", 1)[0]
@@ -441,7 +441,7 @@ def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, 
     captions = sorted((ROOT / "workflow/report").glob("*.rst"))
     figures = [p.stem for p in (run_j2 / "results/figures").glob("*.png")]
     tables = [p.stem for p in (run_j2 / "results/tables").glob("*.md")]
-    assert len(figures) == 17 and len(tables) == 16
+    assert len(figures) == 18 and len(tables) == 16
     assert {c.stem for c in captions} == set(figures) | {f"table_{t}" for t in tables}
     for name in figures:
         assert f"{name}.png" in html, name

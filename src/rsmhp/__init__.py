@@ -27,9 +27,11 @@ Models
                     dpw (compiled tree search with double progressive widening),
                     simulation, recording
 Stages of the pipeline (one module per model and stage)
-  experiments       lqg, estimators, uav, decisions_lqg, decisions_uav: config -> tidy tables
-  analysis          lqg, estimators, uav, decisions_lqg, decisions_uav: tables -> statistics
-  figures           lqg, estimators, uav, decisions: seaborn figures (PNG + PDF)
+  experiments       lqg, estimators, uav, decisions_lqg, decisions_uav, frontier: config ->
+                    tidy tables
+  analysis          lqg, estimators, uav, decisions_lqg, decisions_uav, frontier: tables ->
+                    statistics
+  figures           lqg, estimators, uav, decisions, frontier: seaborn figures (PNG + PDF)
   recording         rerun recordings of sampled trajectory trees
   claims            per study: the claims (key number + verdict rule) from the statistics;
                     claims.paper: the paper's statements, each with its evidence and verdict
