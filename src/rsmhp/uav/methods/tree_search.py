@@ -6,10 +6,10 @@ and its controls come from sampled actions rather than a gradient-based optimise
 budget is ``sims`` simulations per planning step. Config: ``dpw: [{sims: 200}, {sims:
 1000}]``, named ``dpw_s<sims>``.
 
-Search constants, fixed before any run (the literature's usual ranges; not tuned on our
-results): UCB constant :data:`C_UCB` = 0.5 on per-step rewards normalised by the root's
-:math:`\mathrm{tr}\,\hat P`, action widening :data:`K_A` = 4, :data:`ALPHA_A` = 0.25,
-observation widening :data:`K_O` = 4, :data:`ALPHA_O` = 0.25.
+Search constants, chosen before any run and not tuned on our results: UCB constant
+:data:`C_UCB` = 0.5 on per-step rewards normalised by the root's :math:`\mathrm{tr}\,\hat
+P`, action widening :data:`K_A` = 4, :data:`ALPHA_A` = 0.25, observation widening
+:data:`K_O` = 4, :data:`ALPHA_O` = 0.25.
 """
 
 from __future__ import annotations
