@@ -161,3 +161,24 @@ def test_frontier_figure_draws_one_line_per_family():
     assert fig.axes[0].get_xscale() == "log"
     with pytest.raises(ValueError, match="empty"):
         frontier_figure(summarize_frontier(runs.iloc[:0], regret.iloc[:0], 3, 200))
+
+
+def test_bad_frontier_config_is_refused_naming_the_fields():
+    from rsmhp.config import ConfigError, check_config
+
+    cfg = copy.deepcopy(CONFIG)
+    fr = cfg["decisions"]["frontier"]
+    fr["models"] = ["paper", "nowhere"]
+    fr["methods"]["nbo"] = False
+    fr["methods"]["rqmc_nt"] = [16, 48]
+    fr["regret_steps"] = [0, 60]
+    with pytest.raises(ConfigError) as err:
+        check_config(cfg)
+    msg = str(err.value)
+    assert "decisions.frontier.models: ['nowhere'] not model(s) of decisions.uav.models" in msg
+    assert "decisions.frontier.methods.nbo: false (allowed: true" in msg
+    assert "decisions.frontier.methods.rqmc_nt[1]: 48 is not a power of 2" in msg
+    assert "decisions.frontier.regret_steps: [60] not before the run's last step" in msg
+    ok = copy.deepcopy(CONFIG)
+    ok["decisions"]["frontier"]["models"] = []  # no model: the study does not run
+    check_config(ok)
