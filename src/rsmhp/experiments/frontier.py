@@ -115,8 +115,8 @@ def run_frontier_model(
     setup = UAVSetup.from_config(uav_cfg)
     loss = float(cfg["track_loss_error"])
     log.info("frontier %s: %d methods x %d closed-loop runs", model, len(planners), len(runs))
-    with threadpool_limits(limits=1):
-        summaries = parallel_map(_closed_loop_task, jobs, 1, desc=f"frontier {model} runs")
+    # one worker: parallel_map runs in this process with BLAS on one thread
+    summaries = parallel_map(_closed_loop_task, jobs, 1, desc=f"frontier {model} runs")
     run_rows = [
         {
             "model": model,

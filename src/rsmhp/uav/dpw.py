@@ -112,7 +112,6 @@ def _search(
     b_next = np.full(nb_max, -1, np.int64)  # next sibling under the same action
     b_r = np.zeros(nb_max)  # reward of reaching this belief
     b_cnt = np.zeros(nb_max, np.int64)  # transitions into this belief
-    b_depth = np.zeros(nb_max, np.int64)
     # action nodes
     a_u = np.empty((na_max, 2))
     a_N = np.zeros(na_max, np.int64)
@@ -188,7 +187,6 @@ def _search(
                     L, x, w, zeta, ctrl,
                 )  # fmt: skip
                 b_r[c] = -tr / c0
-                b_depth[c] = depth + 1
                 b_next[c] = a_first[a]
                 a_first[a] = c
                 a_nch[a] += 1

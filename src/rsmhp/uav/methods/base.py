@@ -43,9 +43,10 @@ from typing import Any, ClassVar
 
 import numpy as np
 
+from rsmhp.uav import target
 from rsmhp.uav.planner import Belief, Planner, SampledCostPlanner
 
-__all__ = ["COLUMNS", "Hypotheses", "Method"]
+__all__ = ["COLUMNS", "Hypotheses", "Method", "from_design"]
 
 #: the method columns of every UAV table: trajectories averaged, draws per level, kept
 COLUMNS = ("N_T", "N", "M")
@@ -92,6 +93,21 @@ class Hypotheses:
     @property
     def n(self) -> int:
         return int(np.shape(self.states)[0])
+
+
+#: the identity square root: a design of :mod:`rsmhp.designs` given it draws standard normals
+_STANDARD = np.eye(4)
+_STANDARD.flags.writeable = False
+
+
+def from_design(belief: Belief, setup: Any, design, *args: Any) -> Hypotheses:
+    """Hypotheses of a point set of :mod:`rsmhp.designs`: ``design(*args, H + 1, I_4)``
+    gives standard-normal coordinates ``z`` (n, H + 1, 4) and weights, mapped to the initial
+    deviation and the H process noises by :func:`rsmhp.uav.target.from_normals`. Unchecked
+    (valid by construction), like every generator the closed loop calls."""
+    z, weights = design(*args, setup.planner.horizon + 1, _STANDARD)
+    states, noise = target.from_normals(belief.x_hat, belief.P_hat, z, setup.target, check=False)
+    return Hypotheses(states, weights, noise, check=False)
 
 
 @dataclass(frozen=True)

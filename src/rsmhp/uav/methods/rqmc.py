@@ -18,15 +18,11 @@ import numpy as np
 
 from rsmhp import designs, guards
 from rsmhp.palette import METHOD_COLOURS, size_shade
-from rsmhp.uav import target
 from rsmhp.uav.methods import register
-from rsmhp.uav.methods.base import Hypotheses, Method
+from rsmhp.uav.methods.base import Hypotheses, Method, from_design
 from rsmhp.uav.planner import Belief
 
 __all__ = ["RQMC"]
-
-_EYE = np.eye(4)
-_EYE.flags.writeable = False
 
 
 def _power_of_two(name: str, value: Any) -> int:
@@ -86,9 +82,4 @@ class RQMC(Method):
         return size_shade(self.colour, self.n_traj)
 
     def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator) -> Hypotheses:
-        H = setup.planner.horizon
-        z, _ = designs.sobol(rng, self.n_traj, H + 1, _EYE)
-        states, noise = target.from_normals(
-            belief.x_hat, belief.P_hat, z, setup.target, check=False
-        )
-        return Hypotheses.equal(states, noise)
+        return from_design(belief, setup, designs.sobol, rng, self.n_traj)

@@ -18,15 +18,11 @@ import numpy as np
 
 from rsmhp import designs, guards
 from rsmhp.palette import METHOD_COLOURS
-from rsmhp.uav import target
 from rsmhp.uav.methods import register
-from rsmhp.uav.methods.base import Hypotheses, Method
+from rsmhp.uav.methods.base import Hypotheses, Method, from_design
 from rsmhp.uav.planner import Belief
 
 __all__ = ["SigmaPoints", "n_points"]
-
-_EYE = np.eye(4)
-_EYE.flags.writeable = False
 
 
 def n_points(horizon: int) -> int:
@@ -67,9 +63,4 @@ class SigmaPoints(Method):
         return "sigma points"
 
     def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator | None) -> Hypotheses:
-        H = setup.planner.horizon
-        z, w = designs.cubature(H + 1, _EYE)
-        states, noise = target.from_normals(
-            belief.x_hat, belief.P_hat, z, setup.target, check=False
-        )
-        return Hypotheses(states, w, noise, check=False)
+        return from_design(belief, setup, designs.cubature)

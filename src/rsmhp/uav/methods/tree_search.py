@@ -24,7 +24,7 @@ from rsmhp.palette import METHOD_COLOURS
 from rsmhp.uav import dpw, kinematics
 from rsmhp.uav.methods import register
 from rsmhp.uav.methods.base import Hypotheses, Method
-from rsmhp.uav.planner import Belief, PlanResult, _scale
+from rsmhp.uav.planner import Belief, PlanResult
 from rsmhp.uav.stepper import Stepper
 
 __all__ = ["ALPHA_A", "ALPHA_O", "C_UCB", "K_A", "K_O", "TreeSearch", "TreeSearchPlanner"]
@@ -47,7 +47,7 @@ class TreeSearchPlanner:
         self.sims = guards.positive_int("sims", sims)
         self.setup = setup
         self.stepper = Stepper(setup.uav, setup.target, setup.sensor)
-        self.scale = _scale(setup.uav, setup.planner.horizon).reshape(-1, 2)[0].copy()
+        self.scale = np.asarray(setup.uav.control_scale, dtype=float)
 
     def plan(self, belief: Belief, warm_start: np.ndarray, rng: np.random.Generator) -> PlanResult:
         warm = np.clip(np.asarray(warm_start, dtype=float) / self.scale, -1.0, 1.0)
