@@ -169,7 +169,9 @@ def test_bad_uav_values_are_named(path, value, expected):
         ("decisions.map.track_loss_error", 0, r"decisions\.map\.track_loss_error: 0 "),
         ("decisions.map.bootstrap", 10, r"decisions\.map\.bootstrap: 10 "),
         ("decisions.recording.model", "nothere", r"decisions\.recording\.model: 'nothere'"),
-        ("decisions.recording.run", -1, r"decisions\.recording\.run: -1 "),
+        ("decisions.recording.select", "first", r"decisions\.recording\.select: 'first'"),
+        ("decisions.frontier.budget.ms_per_step", 0, r"frontier\.budget\.ms_per_step: 0 "),
+        ("decisions.frontier.claims.margin_pp", -0.1, r"frontier\.claims\.margin_pp: -0\.1 "),
     ],
 )
 def test_bad_decision_values_are_named(path, value, expected):

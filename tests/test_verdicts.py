@@ -2,7 +2,7 @@
 
 import pytest
 
-from rsmhp.verdicts import Case, Rule, at_most, ci_side
+from rsmhp.verdicts import Case, Rule, at_most, ci_side, non_inferior
 
 
 def test_at_most_boundary_is_supported_and_text_names_the_limit():
@@ -95,3 +95,31 @@ def test_ci_side_margin_around_a_nonzero_null_and_bad_margins():
     for bad in (0.0, -1.0, "0.1"):
         with pytest.raises(ValueError, match="margin"):
             ci_side("f", 0.0, claimed="above", margin=bad)
+
+
+@pytest.mark.parametrize(
+    ("low", "high", "verdict"),
+    [
+        (-0.5, -0.2, "supported"),  # better than the reference: no worse than m either
+        (-0.05, 0.099, "supported"),
+        (0.02, 0.08, "supported"),  # significantly worse, but by less than m
+        (-0.05, 0.1, "inconclusive"),  # upper limit on the margin: not below it
+        (0.05, 0.3, "inconclusive"),
+        (0.1, 0.3, "inconclusive"),  # lower limit on the margin: not above it
+        (0.11, 0.3, "not supported"),
+    ],
+)
+def test_non_inferior_boundaries_at_the_margin(low, high, verdict):
+    rule = non_inferior("d", 0.1, margin_text="0.1 pp")
+    assert rule.verdict({"d_low": low, "d_high": high}) == verdict
+
+
+def test_non_inferior_text_and_bad_margin():
+    text = non_inferior("d", 0.1, margin_text="0.1 pp", basis="paired d").text()
+    assert text == (
+        "paired d: supported if the 95% CI of d lies entirely below +0.1 pp (at most 0.1 pp "
+        "worse); not supported if it lies entirely above +0.1 pp; inconclusive otherwise"
+    )
+    for bad in (0.0, -1.0, "0.1", None):
+        with pytest.raises(ValueError, match="margin must be a number > 0"):
+            non_inferior("d", bad, margin_text="x")

@@ -342,6 +342,37 @@ def test_frontier_outputs(run_j2, tiny):
     assert (summary.loc[summary["method"] == "nbo", "error_diff"] == 0).all()
     png = (run_j2 / "results/figures/dec_frontier.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    # in the report: section, claims FR-1..3 per model, figure, both tables
+    report = (run_j2 / "results/paper/replication.md").read_text()
+    assert report.index("## Decision quality: UAV") < report.index("## Planners at equal compute")
+    for model in cfg["models"]:
+        for k in (1, 2, 3):
+            assert f"| FR-{k}-{model} |" in report
+    assert (run_j2 / "results/paper/figures/dec_frontier.png").exists()
+    appendix = (run_j2 / "results/paper/appendix.md").read_text()
+    for table in ("dec_frontier", "dec_frontier_budget"):
+        text = (run_j2 / f"results/tables/{table}.md").read_text()
+        assert text.strip() and text.strip() in appendix
+
+
+def test_frontier_recording_replays_the_run_its_rule_chooses(run_j2, tiny):
+    """decisions.recording: NBO and every budget member, in the run chosen by `select` from
+    the frontier's paired differences (the log says which; the replay equals the table)."""
+    from rsmhp.analysis.frontier import select_run
+
+    rec, fr = tiny["decisions"]["recording"], tiny["decisions"]["frontier"]
+    runs = pd.read_csv(run_j2 / f"results/decisions/frontier/{rec['model']}.csv")
+    run, d = select_run(runs, rec["model"], "rsmhp_nt8", "nbo", rec["select"])
+    log = (run_j2 / "results/logs/decisions_frontier_recording.log").read_text()
+    assert f"run {run} ({rec['select']} of rsmhp_nt8 − nbo: d = {d:+.3f} m)" in log
+    path = run_j2 / f"results/recordings/dec_{rec['model']}_planners.rrd"
+    entities = set()
+    for chunk in RrdReader(path).store().stream():
+        entities.add(str(chunk.entity_path))
+    for m in ["nbo", *fr["budget"]["members"]]:
+        assert f"/{m}/map/uav_path" in entities and f"/error/{m}" in entities
+    assert "/about" in entities
+    assert not list((run_j2 / "results/recordings").glob("dec_*_run*.rrd"))
 
 
 def test_uav_decision_outputs(run_j2, tiny):
@@ -353,11 +384,15 @@ def test_uav_decision_outputs(run_j2, tiny):
     assert (regret["regret"] >= -1e-9 * regret["best_cost"]).all()
     map_df = pd.read_csv(run_j2 / "results/decisions/uav_map.csv")
     n_cells = len(cfg["map"]["rows"]["values"]) * len(cfg["map"]["cols"]["values"])
-    assert len(map_df) == n_cells * len(cfg["map"]["methods"]["rsmhp_nt"])
+    # RS-MHP N_T=8 and 20, RQMC N_T=8, sigma points, tree search 20 sims (every budget member)
+    compared = ["rsmhp_nt8", "rsmhp_nt20", "rqmc_nt8", "sigma", "dpw_s20"]
+    assert set(cfg["frontier"]["budget"]["members"]) <= set(compared)
+    assert list(dict.fromkeys(map_df["comparison"])) == [f"{m} − nbo" for m in compared]
+    assert len(map_df) == n_cells * len(compared)
     assert (map_df["n_runs"] == cfg["map"]["runs"]).all()
     for cell in ("r0c0", "r1c1"):
         runs = pd.read_csv(run_j2 / f"results/decisions/map/{cell}.csv")
-        assert len(runs) == cfg["map"]["runs"] * 2
+        assert len(runs) == cfg["map"]["runs"] * (1 + len(compared))
         assert (run_j2 / f"results/benchmarks/decisions_map_cell/{cell}.tsv").exists()
     report = (run_j2 / "results/paper/replication.md").read_text()
     for cid in ("DEC-6", "DEC-8a", "DEC-8b"):

@@ -23,6 +23,7 @@ from jsonschema import Draft202012Validator, validators
 from jsonschema.exceptions import ValidationError
 
 from rsmhp.uav import methods as uav_methods
+from rsmhp.uav.methods.monte_carlo import MonteCarlo
 
 __all__ = [
     "CONFIG_PATH",
@@ -307,12 +308,14 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
             f"decisions.frontier.models: {unknown} not model(s) of decisions.uav.models "
             f"(allowed: {', '.join(map(str, names))})"
         )
+    fr_models = [m for m in fr.get("models", []) or [] if isinstance(m, str)]
     rec = (dec.get("recording", {}) or {}).get("model")
-    if rec is not None and names and rec not in names:
+    if rec is not None and fr_models and rec not in fr_models:
         problems.append(
-            f"decisions.recording.model: {rec!r} is not a model of decisions.uav.models "
-            f"(allowed: {', '.join(map(str, names))})"
+            f"decisions.recording.model: {rec!r} is not a model of decisions.frontier.models "
+            f"(allowed: {', '.join(fr_models)}; the recording replays one of its runs)"
         )
+    problems += _budget_problems(dec, bool(fr_models))
     mp = dec.get("map", {}) or {}
     claim_method = (dec.get("claims", {}) or {}).get("map_method") or ""
     map_methods = mp.get("methods")
@@ -346,6 +349,68 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
     if keys[0] is not None and keys[0] == keys[1]:
         problems.append(
             f"decisions.map.cols.key: {keys[1]} is also the rows' key (allowed: two different keys)"
+        )
+    return problems
+
+
+def _member_names(methods: Any) -> dict[str, Any]:
+    """name -> Method of a methods block ({} where the block is invalid: reported elsewhere)."""
+    if not isinstance(methods, Mapping):
+        return {}
+    try:
+        return dict(uav_methods.from_config(methods))
+    except (ValueError, TypeError, KeyError):
+        return {}
+
+
+def _budget_problems(dec: Mapping[str, Any], frontier_runs: bool) -> list[str]:
+    """``decisions.frontier.budget.members``: methods of the frontier, one per non-baseline
+    family and one for each such family of the frontier, all run by the map;
+    ``decisions.frontier.claims.sigma_reference``: a Monte-Carlo member of the frontier."""
+    fr = dec.get("frontier", {}) or {}
+    if not frontier_runs:
+        return []
+    problems: list[str] = []
+    path = "decisions.frontier.budget.members"
+    members = list(((fr.get("budget", {}) or {}).get("members", [])) or [])
+    run = _member_names(fr.get("methods"))
+    if not run:
+        return problems
+    unknown = [m for m in members if m not in run]
+    if unknown:
+        problems.append(
+            f"{path}: {unknown} not method(s) of decisions.frontier.methods "
+            f"(allowed: {', '.join(n for n, m in run.items() if not m.baseline)})"
+        )
+    fams: dict[str, list[str]] = {}
+    for name in members:
+        if name in run:
+            fams.setdefault(run[name].family, []).append(name)
+    base = [n for n in members if n in run and run[n].baseline]
+    if base:
+        problems.append(f"{path}: {base} is the baseline (allowed: one member per other family)")
+    twice = {f: n for f, n in fams.items() if len(n) > 1}
+    if twice:
+        problems.append(f"{path}: several members of one family {twice} (allowed: one each)")
+    missing = sorted({m.family for m in run.values() if not m.baseline} - set(fams))
+    if missing:
+        problems.append(
+            f"{path}: no member of the frontier's famil(ies) {missing} (allowed: one member "
+            "of every family decisions.frontier.methods runs)"
+        )
+    map_run = _member_names((dec.get("map", {}) or {}).get("methods"))
+    absent = [m for m in members if m in run and map_run and m not in map_run]
+    if absent:
+        problems.append(
+            f"decisions.map.methods: lacks the budget member(s) {absent} of {path} (allowed: "
+            "a map that runs every budget member, so that it shows each family at the budget)"
+        )
+    ref = (fr.get("claims", {}) or {}).get("sigma_reference")
+    mc = [n for n, m in run.items() if isinstance(m, MonteCarlo)]
+    if ref is not None and mc and ref not in mc:
+        problems.append(
+            f"decisions.frontier.claims.sigma_reference: {ref!r} is not a Monte-Carlo member "
+            f"of decisions.frontier.methods (allowed: {', '.join(mc)})"
         )
     return problems
 

@@ -14,8 +14,8 @@ verdict that holds when no case does::
     rule.text()  # "z = ... per cell: supported if max |z| ≤ 3.2, not supported otherwise"
 
 The cases are tried in order; the first whose condition holds gives the verdict. The common
-shapes have constructors (:func:`at_most`, :func:`ci_side`), whose boundary behaviour is
-tested in ``tests/test_verdicts.py``.
+shapes have constructors (:func:`at_most`, :func:`ci_side`, :func:`non_inferior`), whose
+boundary behaviour is tested in ``tests/test_verdicts.py``.
 """
 
 from __future__ import annotations
@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 from rsmhp.ledger import STATEMENT_VERDICTS
 
-__all__ = ["Case", "Facts", "Rule", "at_most", "ci_side"]
+__all__ = ["Case", "Facts", "Rule", "at_most", "ci_side", "non_inferior"]
 
 Facts = Mapping[str, float]
 
@@ -144,3 +144,32 @@ def ci_side(
         cases.insert(0, Case("equivalent", f"the 95% CI of {name} lies inside {around}", inside))
         cases[1] = Case("supported", f"it lies entirely {claimed} {txt}", first)
     return Rule(basis=basis, cases=tuple(cases), otherwise="inconclusive")
+
+
+def non_inferior(
+    name: str, margin: float, *, margin_text: str, basis: str = "", worse: str = "worse"
+) -> Rule:
+    r"""The non-inferiority rule of a paired difference d = x(new) − x(reference), where
+    larger x is worse: with facts ``<name>_low`` and ``<name>_high`` (the 95% CI of ``name``)
+    and a margin m > 0 fixed before the run, ``supported`` (the new method is at most m
+    ``worse``) if the CI's upper limit lies strictly below m, ``not supported`` if its lower
+    limit lies strictly above m (worse by more than m), ``inconclusive`` otherwise. A CI
+    entirely below 0 (the new method better) is supported too: the claim is "no worse than
+    m", not "equal"."""
+    if not (isinstance(margin, int | float) and margin > 0):
+        raise ValueError(f"margin must be a number > 0, got {margin!r}")
+    m = float(margin)
+    lo, hi = f"{name}_low", f"{name}_high"
+    return Rule(
+        basis=basis,
+        cases=(
+            Case(
+                "supported",
+                f"the 95% CI of {name} lies entirely below +{margin_text} (at most "
+                f"{margin_text} {worse})",
+                lambda f: f[hi] < m,
+            ),
+            Case("not supported", f"it lies entirely above +{margin_text}", lambda f: f[lo] > m),
+        ),
+        otherwise="inconclusive",
+    )

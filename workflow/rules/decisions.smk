@@ -12,8 +12,6 @@ DEC_SCORING = pick(
     DEC["uav"], "n_eval", "polish", "random_starts", "eval_maxiter", "n_random"
 )
 DEC_FIGURES = [*LQG_FIGURES, *UAV_FIGURES]
-DEC_REC = DEC["recording"]
-DEC_RECORDING = f"results/recordings/dec_{DEC_REC['model']}_run{DEC_REC['run']}.rrd"
 REPORT_SECTIONS["decisions_lqg"] = "results/report/decisions_lqg.json"
 REPORT_SECTIONS["decisions_uav"] = "results/report/decisions_uav.json"
 REPORT_FIGURES.extend(DEC_FIGURES)
@@ -189,31 +187,6 @@ rule decisions_figures:
         "../scripts/decisions_figures.py"
 
 
-rule decisions_recording:
-    """Rerun recording of one footprint run: NBO and RS-MHP side by side."""
-    output:
-        DEC_RECORDING,
-    log:
-        "results/logs/decisions_recording.log",
-    benchmark:
-        "results/benchmarks/decisions_recording.tsv"
-    conda:
-        ENV
-    threads: 1
-    resources:
-        mem_mb=2000,
-        runtime=10,
-    params:
-        uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(DEC["uav"]["models"]),
-        methods=canonical(DEC["uav"]["methods"]),
-        recording=canonical(DEC_REC),
-        seed=config["seed"],
-        code=code_digest("workflow/scripts/decisions_recording.py"),
-    script:
-        "../scripts/decisions_recording.py"
-
-
 rule decisions:
     """Target: the whole decision-quality study."""
     input:
@@ -221,4 +194,3 @@ rule decisions:
         rules.decisions_lqg_summary.output,
         rules.decisions_uav_summary.output,
         rules.decisions_figures.output,
-        rules.decisions_recording.output,

@@ -2,9 +2,15 @@
 # paired closed-loop runs and open-loop regret of every method and its planning time per step
 # (one thread: the time is the study's measure of compute), then aggregation and the figure.
 from rsmhp.figures.frontier import FIGURES as FRONTIER_FIGURES
+from rsmhp.narrative.frontier import TABLES as FRONTIER_TABLES
 
 FRONTIER = config["decisions"]["frontier"]
 FRONTIER_MODELS = list(FRONTIER["models"])
+FRONTIER_REC = config["decisions"]["recording"]
+FRONTIER_RECORDING = f"results/recordings/dec_{FRONTIER_REC['model']}_planners.rrd"
+if FRONTIER_MODELS:
+    REPORT_SECTIONS["decisions_frontier"] = "results/report/decisions_frontier.json"
+    REPORT_FIGURES.extend(FRONTIER_FIGURES)
 
 
 wildcard_constraints:
@@ -54,6 +60,8 @@ rule decisions_frontier_summary:
         ),
     output:
         summary="results/decisions/frontier_summary.csv",
+        tables=table_outputs(FRONTIER_TABLES, "Decision study"),
+        section="results/report/decisions_frontier.json",
     log:
         "results/logs/decisions_frontier_summary.log",
     benchmark:
@@ -66,6 +74,7 @@ rule decisions_frontier_summary:
         runtime=10,
     params:
         cfg=canonical(FRONTIER),
+        horizon=config["uav"]["planner"]["horizon"],
         seed=config["seed"],
         code=code_digest("workflow/scripts/decisions_frontier_summary.py"),
     script:
@@ -89,13 +98,42 @@ rule decisions_frontier_figures:
         mem_mb=2000,
         runtime=5,
     params:
+        budget=canonical(FRONTIER["budget"]),
         code=code_digest("workflow/scripts/decisions_frontier_figures.py"),
     script:
         "../scripts/decisions_frontier_figures.py"
 
 
+rule decisions_frontier_recording:
+    """Rerun recording of one frontier run (chosen by decisions.recording.select): NBO and every family's budget member."""
+    input:
+        runs=f"results/decisions/frontier/{FRONTIER_REC['model']}.csv",
+    output:
+        FRONTIER_RECORDING,
+    log:
+        "results/logs/decisions_frontier_recording.log",
+    benchmark:
+        "results/benchmarks/decisions_frontier_recording.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(config["decisions"]["uav"]["models"]),
+        cfg=canonical(FRONTIER),
+        recording=canonical(FRONTIER_REC),
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/decisions_frontier_recording.py"),
+    script:
+        "../scripts/decisions_frontier_recording.py"
+
+
 rule frontier:
-    """Target: the equal-compute study (tables and figure; nothing when no model is configured)."""
+    """Target: the equal-compute study (tables, section, figure, recording; nothing when no model is configured)."""
     input:
         rules.decisions_frontier_summary.output if FRONTIER_MODELS else [],
         rules.decisions_frontier_figures.output if FRONTIER_MODELS else [],
+        rules.decisions_frontier_recording.output if FRONTIER_MODELS else [],

@@ -11,4 +11,5 @@ from rsmhp.pipeline import rule_logging
 with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent
     summary = read_table(snakemake.input.summary, FRONTIER_SUMMARY_COLUMNS)
-    save_figure(frontier_figure(summary), outdir / "dec_frontier")
+    budget = float(snakemake.params.budget["ms_per_step"])
+    save_figure(frontier_figure(summary, budget), outdir / "dec_frontier")

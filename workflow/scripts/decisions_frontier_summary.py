@@ -1,12 +1,16 @@
 """Rule decisions_frontier_summary: per (model, method) compute, closed- and open-loop
-quality with bootstrap CIs (results/decisions/frontier_summary.csv)."""
+quality with bootstrap CIs (results/decisions/frontier_summary.csv), the tables, claims
+FR-1..3 and the report section."""
+
+from pathlib import Path
 
 import pandas as pd
 
 from rsmhp.analysis.frontier import summarize_frontier
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.frontier import frontier_contracts
-from rsmhp.io import write_csv
+from rsmhp.io import write_csv, write_text
+from rsmhp.narrative.frontier import frontier_section, frontier_tables
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake) as log:
@@ -18,11 +22,13 @@ with rule_logging(snakemake) as log:
         c_runs, c_regret = frontier_contracts(p.cfg, model)
         runs.append(read_checked(r_path, c_runs))
         regret.append(read_checked(g_path, c_regret))
-    summary = summarize_frontier(
-        pd.concat(runs, ignore_index=True),
-        pd.concat(regret, ignore_index=True),
-        p.seed,
-        p.cfg["bootstrap"],
-    )
+    runs = pd.concat(runs, ignore_index=True)
+    regret = pd.concat(regret, ignore_index=True)
+    summary = summarize_frontier(runs, regret, p.seed, p.cfg["bootstrap"])
+    tables = frontier_tables(summary, p.cfg)
+    section = frontier_section(runs, regret, summary, tables, p.cfg, p.seed, p.horizon)
     write_csv(summary, snakemake.output.summary)
-    log.info("%d (model, method) rows", len(summary))
+    for path in snakemake.output.tables:
+        write_text(tables[Path(path).stem] + "\n", path)
+    section.save(snakemake.output.section)
+    log.info("%d (model, method) rows, %d claims", len(summary), len(section.claims))

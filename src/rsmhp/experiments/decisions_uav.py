@@ -66,7 +66,6 @@ __all__ = [
     "belief_states",
     "map_cells",
     "merge_variant",
-    "recording_setup",
     "run_map_cell",
     "run_uav_regret",
     "score_state",
@@ -470,25 +469,3 @@ def _closed_loop_task(job) -> dict[str, Any]:
     uav_cfg, spec, seed, run = job
     summary, _ = simulate_run(UAVSetup.from_config(uav_cfg), spec, seed, run)
     return summary
-
-
-def recording_setup(
-    uav: Mapping[str, Any],
-    models: Sequence[Mapping[str, Any]],
-    method_cfg: Mapping[str, Any],
-    model: str,
-) -> tuple[UAVSetup, list[Method]]:
-    """The setup of model variant ``model`` of ``models`` and the methods a decision
-    recording shows: the baseline (NBO) and the configured method that averages over the most
-    hypotheses (ties: the later one in table order; the default config: RS-MHP N_T=250)."""
-    variants = {m["name"]: m for m in models}
-    if model not in variants:
-        raise ValueError(
-            f"decisions.recording.model: {model!r} is not one of {', '.join(variants)}"
-        )
-    setup = UAVSetup.from_config(merge_variant(uav, variants[model]))
-    base = methods.baseline()()
-    others = [m for m in methods.from_config(method_cfg).values() if m.family != base.family]
-    if not others:
-        return setup, [base]
-    return setup, [base, max(others, key=lambda m: (m.n_traj, m.sort_key()))]

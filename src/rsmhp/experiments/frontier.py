@@ -43,7 +43,13 @@ from rsmhp.parallel import parallel_map
 from rsmhp.uav import methods
 from rsmhp.uav.simulation import UAVSetup
 
-__all__ = ["FRONTIER_RUN_COLUMNS", "frontier_contracts", "run_frontier_model", "variant"]
+__all__ = [
+    "FRONTIER_RUN_COLUMNS",
+    "frontier_contracts",
+    "recording_setup",
+    "run_frontier_model",
+    "variant",
+]
 
 log = logging.getLogger(__name__)
 
@@ -146,3 +152,32 @@ def run_frontier_model(
         pd.DataFrame(run_rows, columns=FRONTIER_RUN_COLUMNS),
         pd.DataFrame(regret, columns=REGRET_COLUMNS),
     )
+
+
+def recording_setup(
+    uav: Mapping[str, Any],
+    models: list[Mapping[str, Any]],
+    cfg: Mapping[str, Any],
+    model: str,
+) -> tuple[UAVSetup, list[methods.Method]]:
+    """The setup of the frontier's model variant ``model`` and the methods its recording
+    shows: NBO, then the budget member of every family (``decisions.frontier.budget.members``,
+    in table order). ``cfg`` is ``decisions.frontier``. A model the frontier does not run, or
+    a member it does not run, is refused naming the field."""
+    if model not in list(cfg["models"]):
+        raise ValueError(
+            f"decisions.recording.model: {model!r} is not a model of decisions.frontier.models "
+            f"(allowed: {', '.join(map(str, cfg['models'])) or 'none configured'})"
+        )
+    run = methods.from_config(cfg["methods"], "decisions.frontier.methods")
+    members = list(cfg["budget"]["members"])
+    unknown = [m for m in members if m not in run]
+    if unknown:
+        raise ValueError(
+            f"decisions.frontier.budget.members: {unknown} not run by decisions.frontier.methods "
+            f"(allowed: {', '.join(run)})"
+        )
+    base = methods.baseline()()
+    chosen = sorted((run[m] for m in members), key=lambda m: m.sort_key())
+    setup = UAVSetup.from_config(merge_variant(uav, variant(models, model)))
+    return setup, [base, *chosen]

@@ -231,27 +231,35 @@ def uav_regret_figure(regret: pd.DataFrame) -> plt.Figure:
     return fig
 
 
+#: panels per row of the map figure (more comparisons wrap to further rows)
+MAP_PANELS_PER_ROW = 3
+
+
 def uav_map_figure(map_df: pd.DataFrame) -> plt.Figure:
-    """Heat map per comparison (RS-MHP − NBO): mean paired difference of the closed-loop
-    average location error (m) per cell, diverging colours centred at 0 over the symmetric
-    range ±max |difference| (nothing clipped), '*' where the 95% bootstrap CI excludes 0,
-    track-loss rates (NBO / RS-MHP) under each value; a null footprint radius is labelled
-    "unlimited"."""
+    """Heat map per comparison (method − NBO; at most :data:`MAP_PANELS_PER_ROW` panels per
+    row): mean paired difference of the closed-loop average location error (m) per cell,
+    diverging colours centred at 0 over the symmetric range ±max |difference| (nothing
+    clipped), '*' where the 95% bootstrap CI excludes 0, track-loss rates (NBO / method)
+    under each value; a null footprint radius is labelled "unlimited"."""
     theme()
     comps = list(dict.fromkeys(map_df["comparison"]))
     row_key, col_key = map_df["row_key"].iloc[0], map_df["col_key"].iloc[0]
     rows = list(dict.fromkeys(axis_value(row_key, v) for v in map_df["row_value"]))
     cols = list(dict.fromkeys(axis_value(col_key, v) for v in map_df["col_value"]))
     lim = float(np.abs(map_df["mean_diff"]).max()) or 1.0
+    n_c = min(MAP_PANELS_PER_ROW, len(comps))
+    n_r = -(-len(comps) // n_c)
     fig, axes = plt.subplots(
-        1,
-        len(comps),
-        figsize=(1.3 * len(cols) * len(comps) + 3.2, 1.0 * len(rows) + 2.2),
+        n_r,
+        n_c,
+        figsize=(1.3 * len(cols) * n_c + 3.2, (1.0 * len(rows) + 1.6) * n_r + 0.8),
         squeeze=False,
         layout="constrained",
     )
+    for ax in axes.ravel()[len(comps) :]:
+        ax.set_visible(False)
     image = None
-    for ax, comp in zip(axes[0], comps, strict=True):
+    for ax, comp in zip(axes.ravel(), comps, strict=False):
         sub = map_df[map_df["comparison"] == comp]
         grid = np.full((len(rows), len(cols)), np.nan)
         for _, r in sub.iterrows():
@@ -276,11 +284,11 @@ def uav_map_figure(map_df: pd.DataFrame) -> plt.Figure:
         ax.set_title(" − ".join(method_label(m) for m in comp.split(" − ")))
         ax.set_xlabel(axis_label(col_key))
         ax.set_ylabel(axis_label(row_key))
-    cbar = fig.colorbar(image, ax=axes[0].tolist(), shrink=0.9)
-    cbar.set_label("mean paired difference of average\nlocation error, RS-MHP − NBO (m)")
+    cbar = fig.colorbar(image, ax=axes.ravel().tolist(), shrink=0.9 / n_r**0.5)
+    cbar.set_label("mean paired difference of average\nlocation error, method − NBO (m)")
     fig.suptitle(
-        "Sensitivity map, closed loop (blue: RS-MHP better; *: 95% CI excludes 0; "
-        "loss: track-loss rate NBO/RS-MHP)\ncolour scale ±max |difference| "
+        "Sensitivity map, closed loop (blue: the method better; *: 95% CI excludes 0; "
+        "loss: track-loss rate NBO/method)\ncolour scale ±max |difference| "
         f"= ±{fmt(lim, 3)} m, nothing clipped",
         fontsize=11,
     )

@@ -4,7 +4,9 @@ Columns: model variants. Top row: open-loop relative regret minus NBO's at the s
 states (percentage points); bottom row: closed-loop mean location error minus NBO's on the same
 runs (m). x: planning milliseconds per step (median over runs, log scale). Each family is one
 line through its members in order of compute, in the palette's family colour, with the 95%
-bootstrap CI of every point as a vertical bar; NBO is the reference line at 0.
+bootstrap CI of every point as a vertical bar; NBO is the reference line at 0; the planning
+budget of the equal-compute claims (``decisions.frontier.budget.ms_per_step``), when given,
+is a dotted vertical line.
 """
 
 from __future__ import annotations
@@ -28,8 +30,9 @@ _ROWS = (
 )
 
 
-def frontier_figure(summary: pd.DataFrame) -> plt.Figure:
-    """The frontier of ``summary`` (:func:`rsmhp.analysis.frontier.summarize_frontier`)."""
+def frontier_figure(summary: pd.DataFrame, budget_ms: float | None = None) -> plt.Figure:
+    """The frontier of ``summary`` (:func:`rsmhp.analysis.frontier.summarize_frontier`),
+    with the planning budget ``budget_ms`` (ms per step) marked if given."""
     theme()
     models = list(dict.fromkeys(summary["model"]))
     if not models:
@@ -61,6 +64,8 @@ def frontier_figure(summary: pd.DataFrame) -> plt.Figure:
                     lw=1.4,
                     label=fams[fam].family_label,
                 )
+            if budget_ms is not None:
+                ax.axvline(budget_ms, color="0.35", lw=1.0, ls=":", label="budget")
             ax.set_xscale("log")
             # plain numbers on the decades and 2, 5 between them; no crowded minor labels
             ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))

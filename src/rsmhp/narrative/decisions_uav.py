@@ -78,11 +78,11 @@ def _map_table(map_df: pd.DataFrame) -> str:
             "95% CI (m)": _ci_cells(map_df["ci_low"], map_df["ci_high"], 1, signed=True),
             "p": map_df["p_value"],
             "loss NBO %": (100 * map_df["loss_nbo"]).round(1),
-            "loss RS-MHP %": (100 * map_df["loss_method"]).round(1),
+            "loss method %": (100 * map_df["loss_method"]).round(1),
             "detect NBO %": (100 * map_df["detect_nbo"]).round(1),
-            "detect RS-MHP %": (100 * map_df["detect_method"]).round(1),
+            "detect method %": (100 * map_df["detect_method"]).round(1),
             "regret NBO %": 100 * map_df["regret_nbo"],
-            "regret RS-MHP %": 100 * map_df["regret_method"],
+            "regret method %": 100 * map_df["regret_method"],
         }
     )
     return markdown_table(m, digits=3, missing="undefined", signed=("mean diff (m)",))
@@ -238,9 +238,9 @@ _FIGURE_TEXT = [
     "",
     "![UAV sensitivity map](figures/dec_uav_map.png)",
     "",
-    "*Closed-loop RS-MHP − NBO average location error (m) per map cell; an asterisk "
-    "marks a 95% CI excluding 0; track-loss rates NBO/RS-MHP; colours span ±max "
-    "|difference|, nothing clipped.*",
+    "*Closed-loop method − NBO average location error (m) per map cell, one panel per "
+    "method (RS-MHP, each family at the planning budget); * marks a 95% CI excluding 0; "
+    "track-loss rates NBO/method; colours span ±max |difference|, nothing clipped.*",
 ]
 
 
@@ -270,7 +270,7 @@ def _appendix(cfg: Mapping[str, Any], tables: Mapping[str, str]) -> str:
             tables["dec_uav_regret"],
             "",
             "Sensitivity map: mean paired difference of the closed-loop average location "
-            f"error, RS-MHP − NBO (m), over {int(mcfg['runs'])} runs; p: Wilcoxon signed-rank "
+            f"error, method − NBO (m), over {int(mcfg['runs'])} runs; p: Wilcoxon signed-rank "
             "test ('undefined' if every difference is 0); track loss, detection rate and "
             f"open-loop relative regret (at the belief states of {int(mcfg['regret_runs'])} "
             f"NBO runs, steps {', '.join(str(int(s)) for s in mcfg['regret_steps'])}) in "

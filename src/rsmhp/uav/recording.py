@@ -20,6 +20,7 @@ For each method ``<m>`` (entity per method, its own 2-D view), drawn in the meth
   footprint circle around the UAV, in ``c_m`` when the step measured, faint when it did not
 * ``error/<m>``, ``trace/<m>``  Scalars in ``c_m``: :math:`\\|\\hat p_k - p_k\\|` and
   :math:`\\mathrm{tr}\\,\\hat P_k` (one time-series view each, methods overlaid)
+* ``about``  TextDocument (static, optional): which run this is and why it was chosen
 
 Target and estimate colours differ from every method colour of :mod:`rsmhp.palette` (RGB
 distance > 100), so they cannot be mistaken for a method.
@@ -34,6 +35,7 @@ import uuid
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import rerun as rr
 import rerun.blueprint as rrb
 
@@ -43,7 +45,14 @@ from rsmhp.seeding import canonical_job_id
 from rsmhp.uav.methods import Method
 from rsmhp.uav.simulation import StepInfo, UAVSetup, draw_scenario, simulate_run
 
-__all__ = ["EST_C", "TRUE_C", "ellipse_polygon", "record_uav_run", "uav_blueprint"]
+__all__ = [
+    "EST_C",
+    "TRUE_C",
+    "check_replay",
+    "ellipse_polygon",
+    "record_uav_run",
+    "uav_blueprint",
+]
 
 #: the true target (path and position): lime, unlike any method colour
 TRUE_C = (120, 230, 0)
@@ -111,15 +120,19 @@ class _MethodLogger:
         log(f"trace/{self.name}", rr.Scalars(info.trace))
 
 
-def uav_blueprint(methods: list[str]) -> rrb.Blueprint:
-    """One 2-D map per method (grid) above the error and tr P time series."""
+def uav_blueprint(methods: list[str], note: bool = False) -> rrb.Blueprint:
+    """One 2-D map per method (grid) above the error and tr P time series (and, with
+    ``note``, the text document ``about`` that says which run this is and why)."""
+    series = [
+        rrb.TimeSeriesView(origin="/error", name="target location error (m)"),
+        rrb.TimeSeriesView(origin="/trace", name="tr P"),
+    ]
+    if note:
+        series.append(rrb.TextDocumentView(origin="/about", name="this run"))
     return rrb.Blueprint(
         rrb.Vertical(
             rrb.Grid(*(rrb.Spatial2DView(origin=f"/{m}/map", name=m) for m in methods)),
-            rrb.Horizontal(
-                rrb.TimeSeriesView(origin="/error", name="target location error (m)"),
-                rrb.TimeSeriesView(origin="/trace", name="tr P"),
-            ),
+            rrb.Horizontal(*series),
             row_shares=[3, 1],
         ),
         rrb.TimePanel(state="expanded"),
@@ -134,8 +147,10 @@ def record_uav_run(
     seed: int,
     run: int,
     max_hypotheses: int = 50,
+    note: str = "",
 ) -> tuple[dict[str, int], list[dict]]:
-    """Simulate run ``run`` with every method and record it.
+    """Simulate run ``run`` with every method and record it; a non-empty ``note`` (e.g. why
+    this run was chosen) is logged as the static text document ``about``.
 
     Returns (entity path -> logged rows, the per-method summary rows of the simulations, which
     equal those of the Monte-Carlo study for the same run).
@@ -155,12 +170,15 @@ def record_uav_run(
     rec = rr.RecordingStream("rsmhp_uav", recording_id=str(uuid.uuid5(uuid.NAMESPACE_URL, job)))
     rec.set_log_time_enabled(False)
     Path(path).parent.mkdir(parents=True, exist_ok=True)
-    rec.save(path, default_blueprint=uav_blueprint(names))
+    rec.save(path, default_blueprint=uav_blueprint(names, note=bool(note)))
     rows: dict[str, int] = {}
 
     def log(entity: str, data, static: bool = False) -> None:
         rec.log(entity, data, static=static)
         rows[entity] = rows.get(entity, 0) + 1
+
+    if note:
+        log("about", rr.TextDocument(note), static=True)
 
     summaries = []
     for m in methods:
@@ -174,3 +192,21 @@ def record_uav_run(
         summaries.append(summary)
     rec.disconnect()
     return rows, summaries
+
+
+def check_replay(summaries: list[dict], table: pd.DataFrame, rtol: float = 1e-9) -> None:
+    """Refuse a recording whose replayed runs differ from the study's table rows of the same
+    run (``table``: one row per method with ``method`` and ``mean_error``): the simulation is
+    deterministic given (seed, run, method), so a difference means the table is stale or the
+    code changed under it. Methods absent from the table are refused too."""
+    rows = table.set_index("method")["mean_error"]
+    for s in summaries:
+        m = s["method"]
+        if m not in rows.index:
+            raise ValueError(f"recording: method {m!r} has no row of this run in the study table")
+        want, got = float(rows.loc[m]), float(s["mean_error"])
+        if not np.isclose(got, want, rtol=rtol, atol=0.0):
+            raise ValueError(
+                f"recording: the replay of {m} gives mean error {got!r} m, the study table "
+                f"{want!r} m (allowed: equal to rtol {rtol:g}); rerun the study's rule"
+            )

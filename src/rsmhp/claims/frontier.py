@@ -1,0 +1,302 @@
+r"""Equal-compute study, claims FR-1-<model>, FR-2-<model>, FR-3-<model>: each a key number
+from :mod:`rsmhp.analysis.frontier` and a verdict rule (:mod:`rsmhp.verdicts`) evaluated on
+facts. The compared members are the config's budget members
+(``decisions.frontier.budget.members``: one per family, the largest that fit the planning
+budget per step in the study's first run); the rules' margins are
+``decisions.frontier.claims``. All key numbers are statistical (closed loop, optimiser); all
+claims are beyond the paper (part "beyond"), one per model variant of the study.
+
+* **FR-1** (:func:`fr1_rule`): d = open-loop relative regret of RQMC − that of Monte Carlo
+  (RS-MHP), both budget members, paired per belief state (pp). RQMC decides better:
+  *equivalent* if the 95% bootstrap CI of mean d lies inside ±m (``margin_pp``), else
+  *supported* below 0, *not supported* above 0, *inconclusive* otherwise.
+* **FR-2** (:func:`fr2_rule`): d = regret of the sigma points − that of the Monte-Carlo
+  member ``sigma_reference`` (pp). The sigma points decide as well as it, up to m: *supported*
+  if the CI lies below +m (non-inferiority), *not supported* above +m, *inconclusive*
+  otherwise.
+* **FR-3** (:func:`fr3_rule`): d = closed-loop mean location error of the tree search
+  (PFT-DPW) − that of Monte Carlo, both budget members, paired over runs (m). The tree
+  search tracks better: *equivalent* inside ±``margin_m``, else *supported* below 0, *not
+  supported* above 0, *inconclusive* otherwise. An open-loop regret pointing the other way is
+  named as contrary evidence.
+
+Timing enters no verdict (times differ across machines, decisions reproduce): each claim
+states the members' measured milliseconds per step against the budget, and a member over
+the budget, or a larger member of its family within it, is named as contrary evidence.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import pandas as pd
+
+from rsmhp.analysis.frontier import Paired, budget_check, paired_difference
+from rsmhp.ledger import Claim, KeyNumber
+from rsmhp.markdown import fmt, fmt_ci, param_text
+from rsmhp.palette import method_label
+from rsmhp.uav import methods as registry
+from rsmhp.uav.methods.base import Method
+from rsmhp.uav.methods.monte_carlo import MonteCarlo
+from rsmhp.uav.methods.rqmc import RQMC
+from rsmhp.uav.methods.sigma_points import SigmaPoints
+from rsmhp.uav.methods.tree_search import TreeSearch
+from rsmhp.verdicts import Rule, ci_side, non_inferior
+
+__all__ = [
+    "KEY",
+    "budget_member",
+    "fr1_rule",
+    "fr2_rule",
+    "fr3_rule",
+    "frontier_claims",
+    "paired_facts",
+]
+
+#: the key number of every claim here, as the rules name it (facts ``mean d_low/high``)
+KEY = "mean d"
+
+
+def paired_facts(d: Paired) -> dict[str, float]:
+    """The CI of a paired difference as the facts of the rules here."""
+    return {f"{KEY}_low": float(d.low), f"{KEY}_high": float(d.high)}
+
+
+def fr1_rule(margin_pp: float) -> Rule:
+    """FR-1: RQMC's open-loop regret is below Monte Carlo's (equivalence margin ±m pp)."""
+    return ci_side(
+        KEY,
+        0.0,
+        claimed="below",
+        basis="d = relative regret of RQMC − that of Monte Carlo (RS-MHP), the budget members, "
+        "paired per belief state (pp); 95% bootstrap CI",
+        margin=margin_pp,
+        margin_text=f"{param_text(margin_pp)} pp",
+    )
+
+
+def fr2_rule(margin_pp: float, reference: str) -> Rule:
+    """FR-2: the sigma points decide at most m pp worse than ``reference`` (non-inferiority)."""
+    return non_inferior(
+        KEY,
+        margin_pp,
+        margin_text=f"{param_text(margin_pp)} pp",
+        basis=f"d = relative regret of the sigma points − that of {method_label(reference)}, "
+        "paired per belief state (pp); 95% bootstrap CI",
+    )
+
+
+def fr3_rule(margin_m: float) -> Rule:
+    """FR-3: the tree search's closed-loop error is below Monte Carlo's (margin ±m m)."""
+    return ci_side(
+        KEY,
+        0.0,
+        claimed="below",
+        basis="d = closed-loop mean location error of the tree search (PFT-DPW) − that of "
+        "Monte Carlo (RS-MHP), the budget members, paired over runs (m); 95% bootstrap CI",
+        margin=margin_m,
+        margin_text=f"{param_text(margin_m)} m",
+    )
+
+
+def budget_member(members: Sequence[str], family: type[Method]) -> str | None:
+    """The budget member of ``family`` (a registry class) in ``members``, if any."""
+    hits = [m for m in members if isinstance(registry.from_name(m), family)]
+    return hits[0] if hits else None
+
+
+def _key(name: str, d: Paired, unit: str, null: float) -> KeyNumber:
+    return KeyNumber(
+        name,
+        float(d.mean),
+        float(d.low),
+        float(d.high),
+        unit=unit,
+        reproducible="statistical",
+        digits=3 if unit == "m" else 2,
+        null=null,
+    )
+
+
+def _timing(check: pd.DataFrame, model: str, names: Sequence[str], budget: float) -> str:
+    """``RQMC N_T=256 0.73 ms, RS-MHP N_T=256 0.49 ms per step (budget 1.25 ms)``."""
+    c = check[check["model"] == model].set_index("member")
+    parts = [
+        f"{method_label(n)} {fmt(float(c.loc[n, 'plan_ms']), 3)} ms" for n in names if n in c.index
+    ]
+    return f"{', '.join(parts)} per step, median over runs (budget {param_text(budget)} ms)"
+
+
+def _timing_contrary(check: pd.DataFrame, model: str, names: Sequence[str]) -> list[str]:
+    """A member over the budget on this run, or a larger member of its family within it."""
+    c = check[check["model"] == model].set_index("member")
+    out = []
+    for n in names:
+        if n not in c.index:
+            continue
+        r = c.loc[n]
+        if not bool(r["fits"]):
+            out.append(f"{method_label(n)} took {fmt(float(r['plan_ms']), 3)} ms, over the budget")
+        elif r["largest_fitting"] and r["largest_fitting"] != n:
+            out.append(
+                f"{method_label(str(r['largest_fitting']))} ({fmt(float(r['largest_ms']), 3)} "
+                f"ms) also fits the budget on this run"
+            )
+    return out
+
+
+def _diff_text(d: Paired, unit: str, digits: int = 3) -> str:
+    return f"{fmt(d.mean, digits, True)} {unit} {fmt_ci(d.low, d.high, digits, True)}"
+
+
+def _model_claims(
+    model: str,
+    runs: pd.DataFrame,
+    regret: pd.DataFrame,
+    summary: pd.DataFrame,
+    check: pd.DataFrame,
+    members: Sequence[str],
+    cfg: Mapping[str, Any],
+    seed: int,
+    n_boot: int,
+) -> list[Claim]:
+    rules = cfg["claims"]
+    budget = float(cfg["budget"]["ms_per_step"])
+    margin_pp, margin_m = float(rules["margin_pp"]), float(rules["margin_m"])
+    mc = budget_member(members, MonteCarlo)
+    rqmc = budget_member(members, RQMC)
+    sigma = budget_member(members, SigmaPoints)
+    dpw = budget_member(members, TreeSearch)
+    ref = str(rules["sigma_reference"])
+    run_methods = set(summary.loc[summary["model"] == model, "method"])
+    setup = f"UAV '{model}', equal planning budget {param_text(budget)} ms per step"
+    src = "Beyond the paper (its UAV study compares NBO, RS-MHP and pruning only): "
+    out: list[Claim] = []
+
+    def diff(table: pd.DataFrame, a: str, b: str, measure: str) -> Paired:
+        return paired_difference(table, model, a, b, measure, seed, n_boot)
+
+    if mc and rqmc and {mc, rqmc} <= run_methods:
+        d = diff(regret, rqmc, mc, "regret")
+        e = diff(runs, rqmc, mc, "error")
+        rule = fr1_rule(margin_pp)
+        out.append(
+            Claim(
+                f"FR-1-{model}",
+                f"On '{model}', at the planning budget, {method_label(rqmc)} chooses better "
+                f"plans than {method_label(mc)} (lower open-loop relative regret)",
+                src + "the estimator study's variance reduction of scrambled Sobol' points, "
+                "tested as a planner at equal compute",
+                _key(
+                    f"{method_label(rqmc)} − {method_label(mc)} relative regret, paired mean",
+                    d,
+                    "pp",
+                    0.0,
+                ),
+                rule.verdict(paired_facts(d)),
+                rule.text(),
+                measured=f"{d.n} belief states; closed loop {method_label(rqmc)} − "
+                f"{method_label(mc)} = {_diff_text(e, 'm')} over {e.n} paired runs; "
+                f"{_timing(check, model, [rqmc, mc], budget)}",
+                part="beyond",
+                setup=setup,
+                contrary="; ".join(_timing_contrary(check, model, [rqmc, mc])),
+            )
+        )
+    if sigma and ref in run_methods and sigma in run_methods:
+        d = diff(regret, sigma, ref, "regret")
+        e = diff(runs, sigma, ref, "error")
+        rule = fr2_rule(margin_pp, ref)
+        out.append(
+            Claim(
+                f"FR-2-{model}",
+                f"On '{model}', the sigma points decide as well as {method_label(ref)} up to "
+                f"{param_text(margin_pp)} pp of open-loop relative regret",
+                src + "a deterministic cubature set of the joint belief in place of random "
+                "hypotheses",
+                _key(
+                    f"sigma points − {method_label(ref)} relative regret, paired mean",
+                    d,
+                    "pp",
+                    margin_pp,
+                ),
+                rule.verdict(paired_facts(d)),
+                rule.text(),
+                measured=f"{d.n} belief states; closed loop sigma points − {method_label(ref)} "
+                f"= {_diff_text(e, 'm')} over {e.n} paired runs; "
+                f"{_timing(check, model, [sigma, ref], budget)}",
+                part="beyond",
+                setup=setup,
+                contrary="; ".join(_timing_contrary(check, model, [sigma])),
+            )
+        )
+    if mc and dpw and {mc, dpw} <= run_methods:
+        e = diff(runs, dpw, mc, "error")
+        d = diff(regret, dpw, mc, "regret")
+        rule = fr3_rule(margin_m)
+        s = summary[summary["model"] == model].set_index("method")
+        contrary = _timing_contrary(check, model, [dpw, mc])
+        if e.high < 0 < d.low:
+            contrary.insert(
+                0,
+                f"its open-loop plans are worse: relative regret {method_label(dpw)} − "
+                f"{method_label(mc)} = {_diff_text(d, 'pp', 2)}",
+            )
+        elif e.low > 0 > d.high:
+            contrary.insert(
+                0,
+                f"its open-loop plans are better: relative regret {method_label(dpw)} − "
+                f"{method_label(mc)} = {_diff_text(d, 'pp', 2)}",
+            )
+        out.append(
+            Claim(
+                f"FR-3-{model}",
+                f"On '{model}', at the planning budget, the tree search ({method_label(dpw)}, "
+                f"PFT-DPW) tracks better than {method_label(mc)} (lower closed-loop error)",
+                src + "the paper calls RS-MHP a Monte-Carlo tree search but never compares it "
+                "with the progressive-widening tree search used for continuous belief spaces",
+                _key(
+                    f"{method_label(dpw)} − {method_label(mc)} mean location error, paired mean",
+                    e,
+                    "m",
+                    0.0,
+                ),
+                rule.verdict(paired_facts(e)),
+                rule.text(),
+                measured=f"{e.n} paired runs; mean error {fmt(float(s.loc[dpw, 'mean_error']))} "
+                f"vs {fmt(float(s.loc[mc, 'mean_error']))} m; track lost in "
+                f"{fmt(100 * float(s.loc[dpw, 'lost_rate']), 3)}% vs "
+                f"{fmt(100 * float(s.loc[mc, 'lost_rate']), 3)}% of runs; open-loop relative "
+                f"regret {method_label(dpw)} − {method_label(mc)} = {_diff_text(d, 'pp', 2)} "
+                f"over {d.n} belief states; {_timing(check, model, [dpw, mc], budget)}",
+                part="beyond",
+                setup=setup,
+                contrary="; ".join(contrary),
+            )
+        )
+    return out
+
+
+def frontier_claims(
+    runs: pd.DataFrame,
+    regret: pd.DataFrame,
+    summary: pd.DataFrame,
+    cfg: Mapping[str, Any],
+    seed: int,
+) -> list[Claim]:
+    """FR-1..3 per model of ``summary`` (module doc), in the config's model order. ``runs``
+    and ``regret``: the study's tables of every model; ``summary``:
+    :func:`rsmhp.analysis.frontier.summarize_frontier`; ``cfg``: ``decisions.frontier``."""
+    for key in ("budget", "claims", "bootstrap"):
+        if key not in cfg:
+            raise ValueError(f"decisions.frontier lacks {key!r} (the config schema fills it)")
+    members = list(cfg["budget"]["members"])
+    if summary.empty or not members:
+        return []
+    check = budget_check(summary, members, float(cfg["budget"]["ms_per_step"]))
+    n_boot = int(cfg["bootstrap"])
+    out: list[Claim] = []
+    for model in dict.fromkeys(summary["model"]):
+        out += _model_claims(model, runs, regret, summary, check, members, cfg, seed, n_boot)
+    return out

@@ -1,0 +1,212 @@
+"""Equal-compute study of the planners, report section (order 32): the Markdown tables of the
+frontier and of the budget check, a short body (setting, findings, figure) and the appendix,
+assembled from :mod:`rsmhp.analysis.frontier` and the claims of
+:mod:`rsmhp.claims.frontier`. Every number is read from the tables or the claims."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from rsmhp.analysis.frontier import budget_check
+from rsmhp.claims.frontier import frontier_claims
+from rsmhp.figures.frontier import FIGURES
+from rsmhp.ledger import Claim, Section
+from rsmhp.markdown import fmt, fmt_ci, markdown_table, param_text
+from rsmhp.palette import method_label
+from rsmhp.uav import methods as registry
+from rsmhp.uav.methods.tree_search import ALPHA_A, ALPHA_O, C_UCB, K_A, K_O
+
+__all__ = ["FIGURES", "TABLES", "frontier_section", "frontier_tables"]
+
+#: table stems of the section (the summary rule writes them; see frontier.smk)
+TABLES = ("dec_frontier", "dec_frontier_budget")
+
+
+def _ci(lo: pd.Series, hi: pd.Series, digits: int = 3, signed: bool = True) -> list[str]:
+    return [
+        fmt_ci(a, b, digits, signed) if np.isfinite(a) and np.isfinite(b) else "undefined"
+        for a, b in zip(lo, hi, strict=True)
+    ]
+
+
+def _frontier_table(summary: pd.DataFrame) -> str:
+    t = pd.DataFrame(
+        {
+            "model": summary["model"],
+            "method": summary["method"].map(method_label),
+            "ms/step": summary["plan_ms"],
+            "runs": summary["runs"].astype(int),
+            "error (m)": summary["mean_error"],
+            "− NBO (m)": summary["error_diff"],
+            "95% CI (m)": _ci(summary["error_diff_low"], summary["error_diff_high"]),
+            "lost %": (100 * summary["lost_rate"]).round(1),
+            "states": summary["states"].astype(int),
+            "regret %": summary["regret_pct"],
+            "− NBO (pp)": summary["regret_diff_pp"],
+            "95% CI (pp)": _ci(summary["regret_diff_pp_low"], summary["regret_diff_pp_high"]),
+        }
+    )
+    return markdown_table(t, digits=3, missing="undefined", signed=("− NBO (m)", "− NBO (pp)"))
+
+
+def _budget_table(check: pd.DataFrame) -> str:
+    t = pd.DataFrame(
+        {
+            "model": check["model"],
+            "family": [registry.from_name(m).family_label for m in check["member"]],
+            "budget member": check["member"].map(method_label),
+            "ms/step": check["plan_ms"],
+            "within budget": ["yes" if f else "no" for f in check["fits"]],
+            "largest member within budget (this run)": [
+                method_label(m) if m else "none" for m in check["largest_fitting"]
+            ],
+        }
+    )
+    return markdown_table(t, digits=3)
+
+
+def frontier_tables(summary: pd.DataFrame, cfg: Mapping[str, Any]) -> dict[str, str]:
+    """Markdown tables ``dec_frontier`` (every model and method: planning ms per step,
+    closed-loop error and its paired difference with NBO, track loss, open-loop relative
+    regret and its paired difference) and ``dec_frontier_budget`` (each budget member against
+    the budget on this run's times); ``cfg``: ``decisions.frontier``."""
+    budget = cfg["budget"]
+    check = budget_check(summary, list(budget["members"]), float(budget["ms_per_step"]))
+    return {
+        "dec_frontier": _frontier_table(summary),
+        "dec_frontier_budget": _budget_table(check) if len(check) else "(no budget members)",
+    }
+
+
+def _setting(cfg: Mapping[str, Any], summary: pd.DataFrame, horizon: int) -> str:
+    members = [method_label(m) for m in cfg["budget"]["members"]]
+    steps = ", ".join(str(int(s)) for s in cfg["regret_steps"])
+    fams = list(dict.fromkeys(summary["family"]))
+    labels = {c.family: c.family_label for c in registry.families()}
+    return (
+        f"Every planner family ({', '.join(labels.get(f, f) for f in fams)}) at several sizes "
+        f"on the model variants {', '.join(repr(m) for m in cfg['models'])}: "
+        f"{int(cfg['runs'])} paired closed-loop runs per method (the same scenarios and "
+        "noise for every method), the planning milliseconds per step measured in the same "
+        "one-thread job (median over runs), and the open-loop relative regret at the belief "
+        f"states of {int(cfg['regret_runs'])} NBO runs at steps {steps}, scored as in the "
+        "decision study. **RQMC**: scrambled Sobol' points through the normal quantile, a "
+        "fresh scramble per planning step; **antithetic**: pairs (w, −w); **sigma points**: "
+        f"the {8 * (horizon + 1)} equally weighted cubature points ±√n e_i of the joint "
+        f"Gaussian of the target belief and the {horizon} steps of process noise (n = "
+        f"{4 * (horizon + 1)}); **tree search**: PFT-DPW over Kalman beliefs (a belief node's "
+        "children are sampled controls, its observation children sampled measurements, both "
+        "widened progressively; reward −tr P), with a budget in simulations per planning "
+        "step. Claims FR-1..3 compare one member per family at the **planning budget** of "
+        f"{param_text(float(cfg['budget']['ms_per_step']))} ms per step: {', '.join(members)} "
+        "(fixed in the config as the largest members within the budget in the study's first "
+        "run; the appendix checks them against this run's times)."
+    )
+
+
+def _claim_text(c: Claim) -> str:
+    k = c.key
+    unit = " m" if k.unit == "m" else " pp"
+    out = (
+        f"{k.name.split(',')[0]} on '{c.id.split('-', 2)[2]}': "
+        f"{fmt(k.value, k.digits, True)}{unit} {fmt_ci(k.ci_low, k.ci_high, k.digits, True)} "
+        f"({c.id} {c.verdict})"
+    )
+    return out + (f"; contrary: {c.contrary}" if c.contrary else "")
+
+
+def _findings(claims: Sequence[Claim], summary: pd.DataFrame) -> str:
+    out = []
+    for prefix, lead in (
+        ("FR-1-", "RQMC against Monte Carlo at the budget, open-loop relative regret"),
+        ("FR-2-", "Sigma points against Monte Carlo, open-loop relative regret"),
+        ("FR-3-", "Tree search against Monte Carlo at the budget, closed-loop location error"),
+    ):
+        sel = [c for c in claims if c.id.startswith(prefix)]
+        if sel:
+            out.append(f"{lead}: " + "; ".join(_claim_text(c) for c in sel) + ".")
+    base = registry.baseline()().name
+    for model, s in summary.groupby("model", sort=False):
+        others = s[s["method"] != base].dropna(subset=["error_diff_high"])
+        better = others[others["error_diff_high"] < 0]
+        worse = others[others["error_diff_low"] > 0]
+        out.append(
+            f"Against NBO on '{model}' (closed loop, {int(s['runs'].iloc[0])} paired runs): "
+            f"{len(better)} of {len(others)} members have a CI below 0"
+            + (f" ({', '.join(method_label(m) for m in better['method'])})" if len(better) else "")
+            + f", {len(worse)} above 0"
+            + (f" ({', '.join(method_label(m) for m in worse['method'])})" if len(worse) else "")
+            + f"; NBO plans in {fmt(float(s.loc[s['method'] == base, 'plan_ms'].iloc[0]), 2)} ms "
+            f"per step, the others in {fmt(float(others['plan_ms'].min()), 2)} to "
+            f"{fmt(float(others['plan_ms'].max()), 2)} ms."
+        )
+    return " ".join(out)
+
+
+_FIGURE = [
+    "![Planner frontier](figures/dec_frontier.png)",
+    "",
+    "*Decision quality against planning milliseconds per step (log scale), one line per "
+    "family through its members; top: open-loop relative regret − NBO's (pp), bottom: "
+    "closed-loop mean location error − NBO's (m), below 0 better than NBO; bars: 95% "
+    "bootstrap CIs; dotted: the planning budget of FR-1..3.*",
+]
+
+
+def _appendix(cfg: Mapping[str, Any], tables: Mapping[str, str]) -> str:
+    return "\n".join(
+        [
+            "Per model and method: planning ms per step (median over runs, one thread, "
+            "measured on this machine: the one column of this study that differs across "
+            "machines and reruns), mean location error over runs and its paired difference "
+            f"with NBO, track loss (final error above {param_text(cfg['track_loss_error'])} "
+            "m), open-loop relative regret (%) and its paired difference with NBO at the same "
+            "belief states (pp); CIs: 95% percentile bootstrap over runs or states "
+            f"({int(cfg['bootstrap'])} resamples).",
+            "",
+            tables["dec_frontier"],
+            "",
+            f"Budget members against the budget of "
+            f"{param_text(float(cfg['budget']['ms_per_step']))} ms per step on this run's "
+            "times (a member over the budget, or a larger member within it, is named as "
+            "contrary evidence of the claims that use it):",
+            "",
+            tables["dec_frontier_budget"],
+            "",
+            f"Tree search constants (`rsmhp.uav.methods.tree_search`, chosen before any run): "
+            f"UCB exploration c = {C_UCB} on per-step rewards −tr P / tr P̂ of the root, action "
+            f"widening k_a = {K_A:g}, α_a = {ALPHA_A}, observation widening k_o = {K_O:g}, "
+            f"α_o = {ALPHA_O}; the first action at each depth is the warm start's, rollouts "
+            "follow the warm start; the plan follows the most visited actions.",
+        ]
+    )
+
+
+def frontier_section(
+    runs: pd.DataFrame,
+    regret: pd.DataFrame,
+    summary: pd.DataFrame,
+    tables: Mapping[str, str],
+    cfg: Mapping[str, Any],
+    seed: int,
+    horizon: int,
+) -> Section:
+    """The equal-compute study's report section (order 32); ``cfg`` is
+    ``decisions.frontier``, ``horizon`` the planners' H (``uav.planner.horizon``)."""
+    claims = frontier_claims(runs, regret, summary, cfg, seed)
+    body = "\n".join(
+        [_setting(cfg, summary, horizon), "", _findings(claims, summary), "", *_FIGURE]
+    )
+    return Section(
+        key="decisions_frontier",
+        title="Planners at equal compute",
+        order=32,
+        body=body,
+        claims=claims,
+        figures=list(FIGURES),
+        appendix=_appendix(cfg, tables),
+    )

@@ -1,0 +1,46 @@
+"""Rule decisions_frontier_recording: one closed-loop run of a frontier model variant, NBO and
+every family's budget member side by side, in the run chosen by decisions.recording.select
+from the frontier's paired differences (Monte-Carlo budget member − NBO)."""
+
+from rsmhp.analysis.frontier import select_run
+from rsmhp.claims.frontier import budget_member
+from rsmhp.contracts import read_checked
+from rsmhp.experiments.frontier import frontier_contracts, recording_setup
+from rsmhp.pipeline import rule_logging
+from rsmhp.uav.methods import baseline
+from rsmhp.uav.methods.monte_carlo import MonteCarlo
+from rsmhp.uav.recording import check_replay, record_uav_run
+
+with rule_logging(snakemake) as log:
+    p = snakemake.params
+    rec, cfg = p.recording, p.cfg
+    model = rec["model"]
+    setup, methods = recording_setup(p.uav, p.models, cfg, model)
+    runs = read_checked(snakemake.input.runs, frontier_contracts(cfg, model)[0])
+    base = baseline()().name
+    compare = budget_member(cfg["budget"]["members"], MonteCarlo) or methods[-1].name
+    run, d = select_run(runs, model, compare, base, rec["select"])
+    log.info("%s: run %d (%s of %s − %s: d = %+.3f m)", model, run, rec["select"], compare, base, d)
+    note = (
+        f"Run {run} of model '{model}', chosen by decisions.recording.select = "
+        f"{rec['select']} on d_r = mean location error of {compare} − {base} over the "
+        f"frontier's runs (this run: d = {d:+.3f} m)."
+    )
+    rows, summaries = record_uav_run(
+        snakemake.output[0],
+        setup,
+        methods,
+        seed=p.seed,
+        run=run,
+        max_hypotheses=int(rec["max_hypotheses"]),
+        note=note,
+    )
+    check_replay(summaries, runs[runs["run"] == run])
+    for s in summaries:
+        log.info(
+            "%s: mean error %.2f m, detections %.0f%%",
+            s["method"],
+            s["mean_error"],
+            100 * s.get("detect_rate", 1.0),
+        )
+    log.info("logged %d entities, %d rows", len(rows), sum(rows.values()))
