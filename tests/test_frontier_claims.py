@@ -25,6 +25,7 @@ from rsmhp.analysis.frontier import (
     summarize_frontier,
 )
 from rsmhp.claims.frontier import KEY, fr1_rule, fr2_rule, fr3_rule, frontier_claims
+from rsmhp.markdown import fmt
 
 ROOT = Path(__file__).resolve().parents[1]
 CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
@@ -219,8 +220,9 @@ def test_section_states_every_claim_and_the_budget():
         "FR-3-m",
     ]
     for c in sec.claims:
-        assert f"({c.id} {c.verdict}" in sec.body
-    assert "56 equally weighted cubature points" in sec.body  # 8 (H + 1), H = 6
+        k = c.key
+        assert f"'m' {fmt(k.value, k.digits, True)}" in sec.body and f"({c.verdict})" in sec.body
+    assert "56 equally weighted cubature points" in sec.appendix  # 8 (H + 1), H = 6
     assert "nan" not in sec.body.lower() and "nan" not in sec.appendix.lower()
     assert (
         "| RQMC N_T=16 " in tables["dec_frontier_budget"]

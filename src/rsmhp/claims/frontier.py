@@ -69,8 +69,7 @@ def fr1_rule(margin_pp: float) -> Rule:
         KEY,
         0.0,
         claimed="below",
-        basis="d = relative regret of RQMC − that of Monte Carlo (RS-MHP), the budget members, "
-        "paired per belief state (pp); 95% bootstrap CI",
+        basis="d = relative regret of RQMC − RS-MHP (budget members), paired per belief state (pp)",
         margin=margin_pp,
         margin_text=f"{param_text(margin_pp)} pp",
     )
@@ -82,8 +81,8 @@ def fr2_rule(margin_pp: float, reference: str) -> Rule:
         KEY,
         margin_pp,
         margin_text=f"{param_text(margin_pp)} pp",
-        basis=f"d = relative regret of the sigma points − that of {method_label(reference)}, "
-        "paired per belief state (pp); 95% bootstrap CI",
+        basis=f"d = relative regret of the sigma points − {method_label(reference)}, paired "
+        "per belief state (pp)",
     )
 
 
@@ -93,8 +92,8 @@ def fr3_rule(margin_m: float) -> Rule:
         KEY,
         0.0,
         claimed="below",
-        basis="d = closed-loop mean location error of the tree search (PFT-DPW) − that of "
-        "Monte Carlo (RS-MHP), the budget members, paired over runs (m); 95% bootstrap CI",
+        basis="d = closed-loop mean location error of the tree search − RS-MHP (budget "
+        "members), paired over runs (m)",
         margin=margin_m,
         margin_text=f"{param_text(margin_m)} m",
     )

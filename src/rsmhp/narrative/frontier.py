@@ -82,66 +82,69 @@ def frontier_tables(summary: pd.DataFrame, cfg: Mapping[str, Any]) -> dict[str, 
     }
 
 
-def _setting(cfg: Mapping[str, Any], summary: pd.DataFrame, horizon: int) -> str:
+def _setting(cfg: Mapping[str, Any], summary: pd.DataFrame) -> str:
     members = [method_label(m) for m in cfg["budget"]["members"]]
-    steps = ", ".join(str(int(s)) for s in cfg["regret_steps"])
     fams = list(dict.fromkeys(summary["family"]))
     labels = {c.family: c.family_label for c in registry.families()}
     return (
         f"Every planner family ({', '.join(labels.get(f, f) for f in fams)}) at several sizes "
-        f"on the model variants {', '.join(repr(m) for m in cfg['models'])}: "
-        f"{int(cfg['runs'])} paired closed-loop runs per method (the same scenarios and "
-        "noise for every method), the planning milliseconds per step measured in the same "
+        f"on {', '.join(repr(m) for m in cfg['models'])}: {int(cfg['runs'])} paired "
+        "closed-loop runs per method, the planning milliseconds per step measured in the same "
         "one-thread job (median over runs), and the open-loop relative regret at the belief "
-        f"states of {int(cfg['regret_runs'])} NBO runs at steps {steps}, scored as in the "
-        "decision study. **RQMC**: scrambled Sobol' points through the normal quantile, a "
-        "fresh scramble per planning step; **antithetic**: pairs (w, −w); **sigma points**: "
-        f"the {8 * (horizon + 1)} equally weighted cubature points ±√n e_i of the joint "
-        f"Gaussian of the target belief and the {horizon} steps of process noise (n = "
-        f"{4 * (horizon + 1)}); **tree search**: PFT-DPW over Kalman beliefs (a belief node's "
-        "children are sampled controls, its observation children sampled measurements, both "
-        "widened progressively; reward −tr P), with a budget in simulations per planning "
-        "step. Claims FR-1..3 compare one member per family at the **planning budget** of "
-        f"{param_text(float(cfg['budget']['ms_per_step']))} ms per step: {', '.join(members)} "
-        "(fixed in the config as the largest members within the budget in the study's first "
-        "run; the appendix checks them against this run's times)."
+        f"states of {int(cfg['regret_runs'])} NBO runs, scored as in the decision study "
+        "(methods: README, 'Planning methods'; the tree search is PFT-DPW over Kalman "
+        "beliefs). Claims FR-1..3 compare one member per family at the **planning budget** "
+        f"of {param_text(float(cfg['budget']['ms_per_step']))} ms per step: "
+        f"{', '.join(members)} (fixed in the config as the largest members within the "
+        "budget in a first run of the study; checked against this run's times in the "
+        "appendix)."
     )
 
 
-def _claim_text(c: Claim) -> str:
-    k = c.key
-    unit = " m" if k.unit == "m" else " pp"
-    out = (
-        f"{k.name.split(',')[0]} on '{c.id.split('-', 2)[2]}': "
-        f"{fmt(k.value, k.digits, True)}{unit} {fmt_ci(k.ci_low, k.ci_high, k.digits, True)} "
-        f"({c.id} {c.verdict})"
-    )
-    return out + (f"; contrary: {c.contrary}" if c.contrary else "")
+#: (claim id prefix, what it compares) of the findings paragraph
+_COMPARED = (
+    ("FR-1-", "RQMC − RS-MHP open-loop regret"),
+    ("FR-2-", "sigma points − RS-MHP regret"),
+    ("FR-3-", "tree search − RS-MHP closed-loop error"),
+)
 
 
 def _findings(claims: Sequence[Claim], summary: pd.DataFrame) -> str:
     out = []
-    for prefix, lead in (
-        ("FR-1-", "RQMC against Monte Carlo at the budget, open-loop relative regret"),
-        ("FR-2-", "Sigma points against Monte Carlo, open-loop relative regret"),
-        ("FR-3-", "Tree search against Monte Carlo at the budget, closed-loop location error"),
-    ):
+    for prefix, lead in _COMPARED:
         sel = [c for c in claims if c.id.startswith(prefix)]
-        if sel:
-            out.append(f"{lead}: " + "; ".join(_claim_text(c) for c in sel) + ".")
+        if not sel:
+            continue
+        parts = []
+        for c in sel:
+            k, unit = c.key, " m" if c.key.unit == "m" else " pp"
+            parts.append(
+                f"'{c.id[len(prefix) :]}' {fmt(k.value, k.digits, True)}{unit} "
+                f"{fmt_ci(k.ci_low, k.ci_high, k.digits, True)} ({c.verdict})"
+            )
+        out.append(f"{prefix[:-1]} ({lead} at the budget): " + "; ".join(parts) + ".")
     base = registry.baseline()().name
     for model, s in summary.groupby("model", sort=False):
         others = s[s["method"] != base].dropna(subset=["error_diff_high"])
+        labels = {c.family: c.family_label for c in registry.families()}
+
+        def fams(rows: pd.DataFrame) -> str:
+            return ", ".join(
+                f"{labels.get(f, f)} {int((rows['family'] == f).sum())}/"
+                f"{int((others['family'] == f).sum())}"
+                for f in dict.fromkeys(rows["family"])
+            )
+
         better = others[others["error_diff_high"] < 0]
         worse = others[others["error_diff_low"] > 0]
         out.append(
-            f"Against NBO on '{model}' (closed loop, {int(s['runs'].iloc[0])} paired runs): "
-            f"{len(better)} of {len(others)} members have a CI below 0"
-            + (f" ({', '.join(method_label(m) for m in better['method'])})" if len(better) else "")
-            + f", {len(worse)} above 0"
-            + (f" ({', '.join(method_label(m) for m in worse['method'])})" if len(worse) else "")
-            + f"; NBO plans in {fmt(float(s.loc[s['method'] == base, 'plan_ms'].iloc[0]), 2)} ms "
-            f"per step, the others in {fmt(float(others['plan_ms'].min()), 2)} to "
+            f"Closed loop against NBO on '{model}' ({int(s['runs'].iloc[0])} paired runs): "
+            f"{len(better)} of {len(others)} members better (CI below 0"
+            + (f": {fams(better)}" if len(better) else "")
+            + f"), {len(worse)} worse"
+            + (f" ({fams(worse)})" if len(worse) else "")
+            + f"; NBO plans in {fmt(float(s.loc[s['method'] == base, 'plan_ms'].iloc[0]), 2)} "
+            f"ms per step, the others in {fmt(float(others['plan_ms'].min()), 2)} to "
             f"{fmt(float(others['plan_ms'].max()), 2)} ms."
         )
     return " ".join(out)
@@ -157,7 +160,7 @@ _FIGURE = [
 ]
 
 
-def _appendix(cfg: Mapping[str, Any], tables: Mapping[str, str]) -> str:
+def _appendix(cfg: Mapping[str, Any], tables: Mapping[str, str], horizon: int) -> str:
     return "\n".join(
         [
             "Per model and method: planning ms per step (median over runs, one thread, "
@@ -177,6 +180,14 @@ def _appendix(cfg: Mapping[str, Any], tables: Mapping[str, str]) -> str:
             "",
             tables["dec_frontier_budget"],
             "",
+            f"Methods: **RQMC**, scrambled Sobol' points through the normal quantile, a fresh "
+            "scramble per planning step; **antithetic**, pairs (w, −w); **sigma points**, the "
+            f"{8 * (horizon + 1)} equally weighted cubature points ±√n e_i of the joint "
+            f"Gaussian of the target belief and the {horizon} steps of process noise (n = "
+            f"{4 * (horizon + 1)}); **tree search**, PFT-DPW over Kalman beliefs (a belief "
+            "node's children are sampled controls, its observation children sampled "
+            "measurements, both widened progressively; reward −tr P), with a budget in "
+            "simulations per planning step. "
             f"Tree search constants (`rsmhp.uav.methods.tree_search`, chosen before any run): "
             f"UCB exploration c = {C_UCB} on per-step rewards −tr P / tr P̂ of the root, action "
             f"widening k_a = {K_A:g}, α_a = {ALPHA_A}, observation widening k_o = {K_O:g}, "
@@ -198,9 +209,7 @@ def frontier_section(
     """The equal-compute study's report section (order 32); ``cfg`` is
     ``decisions.frontier``, ``horizon`` the planners' H (``uav.planner.horizon``)."""
     claims = frontier_claims(runs, regret, summary, cfg, seed)
-    body = "\n".join(
-        [_setting(cfg, summary, horizon), "", _findings(claims, summary), "", *_FIGURE]
-    )
+    body = "\n".join([_setting(cfg, summary), "", _findings(claims, summary), "", *_FIGURE])
     return Section(
         key="decisions_frontier",
         title="Planners at equal compute",
@@ -208,5 +217,5 @@ def frontier_section(
         body=body,
         claims=claims,
         figures=list(FIGURES),
-        appendix=_appendix(cfg, tables),
+        appendix=_appendix(cfg, tables, horizon),
     )
