@@ -169,7 +169,7 @@ def _model_claims(
     dpw = budget_member(members, TreeSearch)
     ref = str(rules["sigma_reference"])
     run_methods = set(summary.loc[summary["model"] == model, "method"])
-    setup = f"UAV '{model}', equal planning budget {param_text(budget)} ms per step"
+    setup = f"UAV '{model}', budget {param_text(budget)} ms per step"
     src = "Beyond the paper (its UAV study compares NBO, RS-MHP and pruning only): "
     out: list[Claim] = []
 
@@ -183,12 +183,12 @@ def _model_claims(
         out.append(
             Claim(
                 f"FR-1-{model}",
-                f"On '{model}', at the planning budget, {method_label(rqmc)} chooses better "
-                f"plans than {method_label(mc)} (lower open-loop relative regret)",
+                f"At equal planning time, {method_label(rqmc)} chooses better plans than "
+                f"{method_label(mc)} (lower open-loop regret)",
                 src + "the estimator study's variance reduction of scrambled Sobol' points, "
                 "tested as a planner at equal compute",
                 _key(
-                    f"{method_label(rqmc)} − {method_label(mc)} relative regret, paired mean",
+                    f"regret {method_label(rqmc)} − {method_label(mc)}, paired mean",
                     d,
                     "pp",
                     0.0,
@@ -210,12 +210,12 @@ def _model_claims(
         out.append(
             Claim(
                 f"FR-2-{model}",
-                f"On '{model}', the sigma points decide as well as {method_label(ref)} up to "
-                f"{param_text(margin_pp)} pp of open-loop relative regret",
+                f"The sigma points decide as well as {method_label(ref)}, up to "
+                f"{param_text(margin_pp)} pp of open-loop regret",
                 src + "a deterministic cubature set of the joint belief in place of random "
                 "hypotheses",
                 _key(
-                    f"sigma points − {method_label(ref)} relative regret, paired mean",
+                    f"regret sigma points − {method_label(ref)}, paired mean",
                     d,
                     "pp",
                     margin_pp,
@@ -251,12 +251,12 @@ def _model_claims(
         out.append(
             Claim(
                 f"FR-3-{model}",
-                f"On '{model}', at the planning budget, the tree search ({method_label(dpw)}, "
-                f"PFT-DPW) tracks better than {method_label(mc)} (lower closed-loop error)",
+                f"At equal planning time, the tree search ({method_label(dpw)}) tracks better "
+                f"than {method_label(mc)} (lower closed-loop error)",
                 src + "the paper calls RS-MHP a Monte-Carlo tree search but never compares it "
                 "with the progressive-widening tree search used for continuous belief spaces",
                 _key(
-                    f"{method_label(dpw)} − {method_label(mc)} mean location error, paired mean",
+                    f"error {method_label(dpw)} − {method_label(mc)}, paired mean",
                     e,
                     "m",
                     0.0,

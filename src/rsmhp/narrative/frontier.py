@@ -109,6 +109,15 @@ _COMPARED = (
 )
 
 
+def _per_family(rows: pd.DataFrame, of: pd.DataFrame) -> str:
+    """``RS-MHP 3/3, sigma points 1/1``: members of ``rows`` per family, of those in ``of``."""
+    labels = {c.family: c.family_label for c in registry.families()}
+    return ", ".join(
+        f"{labels.get(f, f)} {int((rows['family'] == f).sum())}/{int((of['family'] == f).sum())}"
+        for f in dict.fromkeys(rows["family"])
+    )
+
+
 def _findings(claims: Sequence[Claim], summary: pd.DataFrame) -> str:
     out = []
     for prefix, lead in _COMPARED:
@@ -126,23 +135,14 @@ def _findings(claims: Sequence[Claim], summary: pd.DataFrame) -> str:
     base = registry.baseline()().name
     for model, s in summary.groupby("model", sort=False):
         others = s[s["method"] != base].dropna(subset=["error_diff_high"])
-        labels = {c.family: c.family_label for c in registry.families()}
-
-        def fams(rows: pd.DataFrame) -> str:
-            return ", ".join(
-                f"{labels.get(f, f)} {int((rows['family'] == f).sum())}/"
-                f"{int((others['family'] == f).sum())}"
-                for f in dict.fromkeys(rows["family"])
-            )
-
         better = others[others["error_diff_high"] < 0]
         worse = others[others["error_diff_low"] > 0]
         out.append(
             f"Closed loop against NBO on '{model}' ({int(s['runs'].iloc[0])} paired runs): "
             f"{len(better)} of {len(others)} members better (CI below 0"
-            + (f": {fams(better)}" if len(better) else "")
+            + (f": {_per_family(better, others)}" if len(better) else "")
             + f"), {len(worse)} worse"
-            + (f" ({fams(worse)})" if len(worse) else "")
+            + (f" ({_per_family(worse, others)})" if len(worse) else "")
             + f"; NBO plans in {fmt(float(s.loc[s['method'] == base, 'plan_ms'].iloc[0]), 2)} "
             f"ms per step, the others in {fmt(float(others['plan_ms'].min()), 2)} to "
             f"{fmt(float(others['plan_ms'].max()), 2)} ms."
