@@ -74,10 +74,11 @@ def test_timing_and_code_columns_are_set_aside():
     other = _frame(plan_seconds=[9.0, 8.0, 7.0], code=["rule:def"] * 3)
     out = pt.compare_frames(_frame(), other)
     assert out["status"] == "identical"
-    for name in ("cpu_seconds", "plan_seconds", "plan_seconds_per_run", "seconds", "cpu_median"):
+    timing = ("cpu_seconds", "plan_seconds", "plan_seconds_per_run", "seconds", "cpu_median")
+    for name in (*timing, "plan_ms", "ms"):
         assert pt.is_timing_column(name), name
-    for name in ("mean", "estimate", "n_seconds_x", "cpu", "code"):
-        assert pt.is_timing_column(name) == (name == "n_seconds_x"), name
+    for name in ("mean", "estimate", "n_seconds_x", "cpu", "code", "items", "terms", "n_ms_x"):
+        assert pt.is_timing_column(name) == (name in ("n_seconds_x", "n_ms_x")), name
 
 
 def test_shape_differences():

@@ -40,7 +40,7 @@ run was made by the same code (the report warns when not).
 
 **What is compared** (:func:`compare_results`, :func:`compare_claims`): every CSV and
 Parquet table under both ``results/`` trees (measured times, i.e. columns named like
-``*seconds*`` or ``cpu_*``, and the code stamp ``code`` set aside), each ``identical``
+``*seconds*``, ``*_ms`` or ``cpu_*``, and the code stamp ``code`` set aside), each ``identical``
 (every remaining cell bit for bit) or ``differs`` (per column: cells that differ, largest
 absolute difference, largest relative difference ``|a - b| / max(|a|, |b|)`` and largest
 distance in units in the last place), or missing, or of another shape; and every claim:
@@ -108,7 +108,7 @@ CODE_COLUMN = "code"
 #: before it, the round-trip parser)
 _CSV_EXACT = {} if int(pd.__version__.split(".")[0]) >= 3 else {"float_precision": "round_trip"}
 
-_TIMING = re.compile(r"(.*_)?seconds(_.*)?|cpu_.*")
+_TIMING = re.compile(r"(.*_)?(seconds|ms)(_.*)?|cpu_.*")
 
 #: tables of the statistically reproducible studies (README: UAV closed loop, UAV decisions)
 _STATISTICAL = ("uav/", "decisions/uav_", "decisions/map/")
@@ -438,7 +438,8 @@ def summarise_emulation(
 
 def is_timing_column(name: str) -> bool:
     """A measured time (``cpu_seconds``, ``plan_seconds``, ``plan_seconds_per_run``,
-    ``seconds``, ``cpu_median``, ...): set aside, it differs between any two executions."""
+    ``seconds``, ``cpu_median``, ``plan_ms``, ...): set aside, it differs between any two
+    executions."""
     return bool(_TIMING.fullmatch(str(name)))
 
 
