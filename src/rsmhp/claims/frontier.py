@@ -183,8 +183,8 @@ def _model_claims(
         out.append(
             Claim(
                 f"FR-1-{model}",
-                f"At equal planning time, {method_label(rqmc)} chooses better plans than "
-                f"{method_label(mc)} (lower open-loop regret)",
+                f"On '{model}', within the planning budget, {method_label(rqmc)} chooses better "
+                f"plans than {method_label(mc)} (lower open-loop regret)",
                 src + "the estimator study's variance reduction of scrambled Sobol' points, "
                 "tested as a planner at equal compute",
                 _key(
@@ -210,7 +210,7 @@ def _model_claims(
         out.append(
             Claim(
                 f"FR-2-{model}",
-                f"The sigma points decide as well as {method_label(ref)}, up to "
+                f"On '{model}', the sigma points decide as well as {method_label(ref)}, up to "
                 f"{param_text(margin_pp)} pp of open-loop regret",
                 src + "a deterministic cubature set of the joint belief in place of random "
                 "hypotheses",
@@ -251,8 +251,8 @@ def _model_claims(
         out.append(
             Claim(
                 f"FR-3-{model}",
-                f"At equal planning time, the tree search ({method_label(dpw)}) tracks better "
-                f"than {method_label(mc)} (lower closed-loop error)",
+                f"On '{model}', within the planning budget, {method_label(dpw)} (PFT-DPW) tracks "
+                f"better than {method_label(mc)} (lower closed-loop error)",
                 src + "the paper calls RS-MHP a Monte-Carlo tree search but never compares it "
                 "with the progressive-widening tree search used for continuous belief spaces",
                 _key(
