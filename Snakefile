@@ -57,6 +57,7 @@ include: "workflow/rules/estimators.smk"
 include: "workflow/rules/uav.smk"
 include: "workflow/rules/decisions.smk"
 include: "workflow/rules/frontier.smk"
+include: "workflow/rules/horizon.smk"
 include: "workflow/rules/report.smk"
 
 
@@ -78,4 +79,5 @@ rule all:
         rules.uav.input,
         rules.decisions.input,
         rules.frontier.input,
+        rules.horizon.input,
         rules.report.output,

@@ -24,6 +24,7 @@ from jsonschema.exceptions import ValidationError
 
 from rsmhp.uav import methods as uav_methods
 from rsmhp.uav.methods.monte_carlo import MonteCarlo
+from rsmhp.uav.methods.pruned_tree import PrunedTree
 
 __all__ = [
     "CONFIG_PATH",
@@ -316,6 +317,7 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
             f"(allowed: {', '.join(fr_models)}; the recording replays one of its runs)"
         )
     problems += _budget_problems(dec, bool(fr_models))
+    problems += _horizon_problems(config, names, n_steps)
     mp = dec.get("map", {}) or {}
     claim_method = (dec.get("claims", {}) or {}).get("map_method") or ""
     map_methods = mp.get("methods")
@@ -350,6 +352,50 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
         problems.append(
             f"decisions.map.cols.key: {keys[1]} is also the rows' key (allowed: two different keys)"
         )
+    return problems
+
+
+def _horizon_problems(config: Mapping[str, Any], names: list, n_steps: int) -> list[str]:
+    """``horizon.uav``: models of the decision study, belief-state steps inside a run, NBO
+    among the methods, and claim members that the study runs (HZ-2: a pruned tree and a
+    Monte-Carlo member)."""
+    hz = (config.get("horizon", {}) or {}).get("uav", {}) or {}
+    path = "horizon.uav"
+    problems: list[str] = []
+    models = [m for m in hz.get("models", []) or [] if isinstance(m, str)]
+    unknown = [m for m in models if names and m not in names]
+    if unknown:
+        problems.append(
+            f"{path}.models: {unknown} not model(s) of decisions.uav.models "
+            f"(allowed: {', '.join(map(str, names))})"
+        )
+    late = [s for s in hz.get("steps", []) or [] if isinstance(s, int) and s >= n_steps]
+    if late:
+        problems.append(
+            f"{path}.steps: {late} not before the run's last step (allowed: 0 <= step < "
+            f"uav.scenario.steps = {n_steps})"
+        )
+    methods = hz.get("methods")
+    base = uav_methods.baseline()
+    if isinstance(methods, Mapping) and methods:
+        if not methods.get(base.config_key, base.default):
+            problems.append(
+                f"{path}.methods.{base.config_key}: {str(methods.get(base.config_key)).lower()} "
+                f"(allowed: true; {base.family_label} is the baseline of the regret)"
+            )
+        problems += uav_methods.config_problems(
+            methods, f"{path}.methods", config.get("uav", {}) or {}
+        )
+    run = _member_names(methods)
+    claims = hz.get("claims", {}) or {}
+    for key, family in (("tree", PrunedTree), ("monte_carlo", MonteCarlo)):
+        name = claims.get(key) or ""
+        ok = [n for n, m in run.items() if isinstance(m, family)]
+        if name and run and name not in ok:
+            problems.append(
+                f"{path}.claims.{key}: {name!r} is not a {family.__name__} member of "
+                f"{path}.methods (allowed: {', '.join(ok) or 'none configured'}, or '')"
+            )
     return problems
 
 

@@ -16,6 +16,7 @@ PRIORITY = {
     "estimators_ablation": 1000,
     "decisions_uav": 990,
     "decisions_frontier": 980,
+    "horizon_uav": 970,
     "estimators_summary": 100,
     "lqg_convergence": 100,
     "lqg_nbo_error": 100,

@@ -16,6 +16,8 @@ name a family:
 ``family_label``    human-readable family name; ``colour``: its hex colour in every figure
 ``order``           position of the family in tables and figures (smaller first)
 ``baseline``        True for the one family every comparison is made against (NBO)
+``estimates_cost``  False for a family that has no cost estimate of an arbitrary plan (a
+                    tree search plans over simulated beliefs, not over hypotheses)
 ==================  ==========================================================================
 
 and per instance: :meth:`Method.name` (rule wildcard, table key), :meth:`Method.columns` (the
@@ -125,6 +127,8 @@ class Method(ABC):
     #: whether the planner draws random numbers; ``False`` (a deterministic method such as
     #: NBO) spares the closed loop building the step's stream, and the planner gets ``None``
     uses_rng: ClassVar[bool] = True
+    #: whether :meth:`hypotheses` gives the cost estimate of any plan (False: a tree search)
+    estimates_cost: ClassVar[bool] = True
 
     # ---------------------------------------------------------------- construction
     @classmethod

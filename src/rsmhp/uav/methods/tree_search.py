@@ -112,6 +112,7 @@ class TreeSearch(Method):
     name_pattern: ClassVar[str] = r"dpw_s(\d+)"
     #: the tables' N_T: 0 (no fixed hypotheses; ``sims`` is the budget)
     n_traj: ClassVar[int] = 0
+    estimates_cost: ClassVar[bool] = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "sims", guards.positive_int("sims", self.sims))

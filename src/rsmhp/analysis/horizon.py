@@ -1,0 +1,231 @@
+r"""UAV horizon study: statistics of the cost approximation, the regret and the planning time
+against the horizon H (tables -> numbers, no prose).
+
+Cost approximation, per (model, H, method), from the rows of
+:data:`rsmhp.experiments.horizon.APPROX_COLUMNS`: with the relative error
+:math:`e = (\hat J_m - \hat J_{ref}) / \hat J_{ref}` of a plan's estimate and the relative
+standard error :math:`s` of its reference,
+
+* per belief state: the bias :math:`b = \overline{e}` and the noise-corrected mean square
+  :math:`q = \overline{e^2} - \overline{s^2}` (the reference is independent of the estimate,
+  so :math:`E[e^2] = \mathrm{MSE} + \mathrm{Var}(\hat J_{ref})/J^2`: subtracting the
+  reference's variance leaves the method's own error), both over plans and replicates;
+* ``rel_bias`` = mean of b over states, ``rel_rmse`` = :math:`\sqrt{\max(\overline q, 0)}`,
+  each with a 95% percentile-bootstrap CI over belief states (the resampled unit);
+  ``ref_noise`` = :math:`\sqrt{\overline{s^2}}`, the reference's own relative SE; ``spearman``
+  = mean over (state, replicate) of the rank correlation of estimate and reference over the
+  plans (undefined where the estimate is constant over them, e.g. NBO's single hypothesis
+  outside every plan's footprint: counted in ``spearman_undefined``).
+
+:func:`rmse_growth` is the paired change of ``rel_rmse`` between two horizons, resampling the
+same belief states at both. Regret and time per (model, H, method): mean relative regret
+(against the best plan found), its part due to the cost approximation (against the best of
+the methods' plans), and the median planning milliseconds.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+import pandas as pd
+from scipy import stats as sps
+
+from rsmhp.seeding import job_rng
+
+__all__ = [
+    "APPROX_SUMMARY_COLUMNS",
+    "REGRET_SUMMARY_COLUMNS",
+    "Growth",
+    "rmse_growth",
+    "state_errors",
+    "summarize_approx",
+    "summarize_horizon_regret",
+]
+
+APPROX_SUMMARY_COLUMNS = [
+    "model",
+    "H",
+    "method",
+    "family",
+    "states",
+    "rel_bias",
+    "rel_bias_low",
+    "rel_bias_high",
+    "rel_rmse",
+    "rel_rmse_low",
+    "rel_rmse_high",
+    "ref_noise",
+    "spearman",
+    "spearman_undefined",
+]
+
+REGRET_SUMMARY_COLUMNS = [
+    "model",
+    "H",
+    "method",
+    "family",
+    "states",
+    "regret_pct",
+    "regret_methods_pct",
+    "plan_ms",
+]
+
+_STATE = ["run", "step"]
+
+
+def state_errors(approx: pd.DataFrame) -> pd.DataFrame:
+    """Per (model, H, method, run, step): ``b`` (mean relative error), ``q`` (noise-corrected
+    mean square relative error) and ``s2`` (mean squared relative SE of the reference)."""
+    e = (approx["estimate"] - approx["reference"]) / approx["reference"]
+    s = approx["reference_se"] / approx["reference"]
+    df = approx[["model", "H", "method", "family", *_STATE]].assign(e=e, e2=e * e, s2=s * s)
+    g = df.groupby(["model", "H", "method", "family", *_STATE], sort=False)
+    out = g[["e", "e2", "s2"]].mean().reset_index()
+    return out.assign(b=out["e"], q=out["e2"] - out["s2"])[
+        ["model", "H", "method", "family", *_STATE, "b", "q", "s2"]
+    ]
+
+
+def _rmse_ci(q: np.ndarray, rng: np.random.Generator, n_boot: int) -> tuple[float, float]:
+    idx = rng.integers(0, q.size, size=(n_boot, q.size))
+    boots = np.sqrt(np.maximum(q[idx].mean(axis=1), 0.0))
+    lo, hi = np.quantile(boots, [0.025, 0.975])
+    return float(lo), float(hi)
+
+
+def _spearman(g: pd.DataFrame) -> float:
+    est, ref = g["estimate"].to_numpy(float), g["reference"].to_numpy(float)
+    if np.ptp(est) == 0.0 or np.ptp(ref) == 0.0:
+        return float("nan")
+    return float(sps.spearmanr(est, ref).statistic)
+
+
+def summarize_approx(approx: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFrame:
+    """One row per (model, H, method) of ``approx`` (module docstring), in table order."""
+    per_state = state_errors(approx)
+    rho = (
+        approx.groupby(["model", "H", "method", *_STATE, "replicate"], sort=False)
+        .apply(_spearman, include_groups=False)
+        .rename("rho")
+        .reset_index()
+    )
+    rows = []
+    for (model, H, method, family), g in per_state.groupby(
+        ["model", "H", "method", "family"], sort=False
+    ):
+        key = {"model": model, "H": int(H), "method": method}
+        b, q = g["b"].to_numpy(float), g["q"].to_numpy(float)
+        r = rho[(rho["model"] == model) & (rho["H"] == H) & (rho["method"] == method)]["rho"]
+        if b.size >= 2:
+            b_boot = job_rng(seed, "horizon_bias", **key)
+            idx = b_boot.integers(0, b.size, size=(n_boot, b.size))
+            b_lo, b_hi = (float(v) for v in np.quantile(b[idx].mean(axis=1), [0.025, 0.975]))
+            q_lo, q_hi = _rmse_ci(q, job_rng(seed, "horizon_rmse", **key), n_boot)
+        else:
+            b_lo = b_hi = q_lo = q_hi = float("nan")
+        rows.append(
+            {
+                **key,
+                "family": family,
+                "states": int(b.size),
+                "rel_bias": float(b.mean()),
+                "rel_bias_low": b_lo,
+                "rel_bias_high": b_hi,
+                "rel_rmse": float(np.sqrt(max(q.mean(), 0.0))),
+                "rel_rmse_low": q_lo,
+                "rel_rmse_high": q_hi,
+                "ref_noise": float(np.sqrt(g["s2"].mean())),
+                "spearman": float(r.mean()) if r.notna().any() else float("nan"),
+                "spearman_undefined": int(r.isna().sum()),
+            }
+        )
+    return pd.DataFrame(rows, columns=APPROX_SUMMARY_COLUMNS)
+
+
+class Growth(NamedTuple):
+    """Change of the relative RMSE between two horizons (``h_lo`` -> ``h_hi``), paired over
+    ``n`` belief states, with its 95% bootstrap CI; ``lo_value``/``hi_value`` the RMSEs."""
+
+    mean: float
+    low: float
+    high: float
+    n: int
+    lo_value: float
+    hi_value: float
+    h_lo: int
+    h_hi: int
+
+
+def _q_wide(per: pd.DataFrame, model: str, method: str, hs: tuple[int, int]) -> pd.DataFrame:
+    sel = per[(per["model"] == model) & (per["method"] == method)]
+    wide = sel.pivot_table(index=_STATE, columns="H", values="q")
+    for h in hs:
+        if h not in wide.columns:
+            raise ValueError(
+                f"H = {h} has no cost-approximation rows of {method!r} on {model!r} "
+                f"(horizons: {sorted(int(c) for c in wide.columns)})"
+            )
+    return wide[list(hs)]
+
+
+def _rmse(x: np.ndarray) -> np.ndarray:
+    return np.sqrt(np.maximum(x.mean(axis=-1), 0.0))
+
+
+def rmse_growth(
+    approx: pd.DataFrame,
+    model: str,
+    method: str,
+    h_lo: int,
+    h_hi: int,
+    seed: int,
+    n_boot: int,
+    minus: str | None = None,
+) -> Growth:
+    r""":math:`g = \mathrm{RMSE}_{rel}(H_{hi}) - \mathrm{RMSE}_{rel}(H_{lo})` of ``method``
+    on ``model``, resampling belief states jointly at both horizons (the same states); with
+    ``minus`` another method, :math:`g_{method} - g_{minus}` on jointly resampled states
+    (``lo_value``/``hi_value`` are then ``method``'s RMSEs). ValueError if a horizon lacks a
+    method or fewer than 2 states are shared."""
+    per = state_errors(approx)
+    hs = (int(h_lo), int(h_hi))
+    parts = [_q_wide(per, model, method, hs)]
+    if minus is not None:
+        parts.append(_q_wide(per, model, minus, hs))
+    wide = pd.concat(parts, axis=1, keys=range(len(parts))).dropna()
+    if len(wide) < 2:
+        raise ValueError(f"{method!r} on {model!r}: {len(wide)} shared belief state(s)")
+    q = [
+        (wide[(i, hs[0])].to_numpy(float), wide[(i, hs[1])].to_numpy(float))
+        for i in range(len(parts))
+    ]
+
+    def g(idx: np.ndarray | slice) -> np.ndarray:
+        out = _rmse(q[0][1][idx]) - _rmse(q[0][0][idx])
+        if minus is not None:
+            out = out - (_rmse(q[1][1][idx]) - _rmse(q[1][0][idx]))
+        return out
+
+    key = {"model": model, "method": method, "minus": minus or "", "h_lo": hs[0], "h_hi": hs[1]}
+    rng = job_rng(seed, "horizon_growth", **key)
+    n = len(wide)
+    boots = g(rng.integers(0, n, size=(n_boot, n)))
+    c_lo, c_hi = np.quantile(boots, [0.025, 0.975])
+    a, b = float(_rmse(q[0][0])), float(_rmse(q[0][1]))
+    return Growth(float(g(slice(None))), float(c_lo), float(c_hi), n, a, b, *hs)
+
+
+def summarize_horizon_regret(regret: pd.DataFrame) -> pd.DataFrame:
+    """One row per (model, H, method): mean relative regret (%), its part due to the cost
+    approximation (regret against the best of the methods' plans, % of the best cost) and
+    the median planning milliseconds per step."""
+    df = regret.assign(
+        r=100 * regret["regret_rel"], rm=100 * regret["regret_methods"] / regret["best_cost"]
+    )
+    g = df.groupby(["model", "H", "method", "family"], sort=False)
+    out = g.agg(
+        states=("r", "size"), regret_pct=("r", "mean"), regret_methods_pct=("rm", "mean"),
+        plan_ms=("plan_ms", "median"),
+    ).reset_index()  # fmt: skip
+    return out[REGRET_SUMMARY_COLUMNS]

@@ -1,0 +1,149 @@
+r"""UAV horizon study, claims HZ-1-<model> and HZ-2-<model>: each a key number from
+:mod:`rsmhp.analysis.horizon` and a verdict rule (:mod:`rsmhp.verdicts`). All claims are
+beyond the paper (part "beyond"): the paper plans at H = 6 only. Key numbers are statistical
+(sampled hypotheses, optimiser-free but random). H_lo and H_hi are the smallest and largest
+horizons of ``horizon.uav.H``.
+
+* **HZ-1** (:func:`hz1_rule`): g = relative RMSE of NBO's cost estimate at H_hi − at H_lo
+  (:func:`rsmhp.analysis.horizon.rmse_growth`, the same belief states at both). NBO's cost
+  approximation error grows with H: *supported* if the 95% bootstrap CI of g lies above 0,
+  *not supported* below 0, *inconclusive* otherwise.
+* **HZ-2** (:func:`hz2_rule`): d = g(pruned tree) − g(Monte Carlo with as many trajectories),
+  the members fixed in ``horizon.uav.claims``. The pruned tree's error grows with H more than
+  Monte Carlo's: *supported* if the CI of d lies above 0, *not supported* below 0,
+  *inconclusive* otherwise.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from typing import Any
+
+import pandas as pd
+
+from rsmhp.analysis.horizon import Growth, rmse_growth
+from rsmhp.ledger import Claim, KeyNumber
+from rsmhp.markdown import fmt, fmt_ci
+from rsmhp.palette import method_label
+from rsmhp.uav import methods as registry
+from rsmhp.verdicts import Rule, ci_side
+
+__all__ = ["KEY", "horizon_claims", "hz1_rule", "hz2_rule"]
+
+KEY = "g"
+
+
+def _facts(g: Growth) -> dict[str, float]:
+    return {f"{KEY}_low": g.low, f"{KEY}_high": g.high}
+
+
+def hz1_rule(h_lo: int, h_hi: int) -> Rule:
+    """HZ-1: NBO's relative RMSE is larger at H_hi than at H_lo."""
+    return ci_side(
+        KEY,
+        0.0,
+        claimed="above",
+        basis=f"g = relative RMSE of NBO's cost estimate at H = {h_hi} − at H = {h_lo}, the same "
+        "belief states (bootstrap over states)",
+    )
+
+
+def hz2_rule(tree: str, mc: str, h_lo: int, h_hi: int) -> Rule:
+    """HZ-2: the pruned tree's RMSE grows more from H_lo to H_hi than Monte Carlo's."""
+    return ci_side(
+        KEY,
+        0.0,
+        claimed="above",
+        basis=f"g = growth of the relative RMSE from H = {h_lo} to {h_hi} of "
+        f"{method_label(tree)} − that of {method_label(mc)} (bootstrap over states)",
+    )
+
+
+def _key(name: str, g: Growth) -> KeyNumber:
+    return KeyNumber(
+        name,
+        100 * g.mean,
+        100 * g.low,
+        100 * g.high,
+        unit="pp",
+        reproducible="statistical",
+        digits=2,
+        null=0.0,
+    )
+
+
+def _pct(g: Growth) -> Growth:
+    return g._replace(mean=100 * g.mean, low=100 * g.low, high=100 * g.high)
+
+
+def horizon_claims(
+    approx: pd.DataFrame, summary: pd.DataFrame, cfg: Mapping[str, Any], seed: int
+) -> list[Claim]:
+    """HZ-1 and HZ-2 per model of ``summary`` (module doc). ``approx``: the cost-approximation
+    rows of every (model, H); ``summary``: :func:`rsmhp.analysis.horizon.summarize_approx`;
+    ``cfg``: ``horizon.uav``."""
+    if summary.empty:
+        return []
+    hs = sorted(int(h) for h in summary["H"].unique())
+    if len(hs) < 2:
+        return []
+    h_lo, h_hi, n_boot = hs[0], hs[-1], int(cfg["bootstrap"])
+    base = registry.baseline()().name
+    tree, mc = (
+        (cfg.get("claims", {}) or {}).get("tree"),
+        (cfg.get("claims", {}) or {}).get("monte_carlo"),
+    )
+    out: list[Claim] = []
+    for model in dict.fromkeys(summary["model"]):
+        s = summary[summary["model"] == model]
+        present = set(s["method"])
+        setup = f"UAV '{model}', belief states of NBO runs, H = {h_lo} to {h_hi}"
+        src = "Beyond the paper (which plans at H = 6 only): "
+        if base in present:
+            g = rmse_growth(approx, model, base, h_lo, h_hi, seed, n_boot)
+            rule = hz1_rule(h_lo, h_hi)
+            p = _pct(g)
+            out.append(
+                Claim(
+                    f"HZ-1-{model}",
+                    f"On '{model}', NBO's cost-approximation error grows with the horizon "
+                    f"(relative RMSE at H = {h_hi} above H = {h_lo})",
+                    src + "Sec. II says NBO ignores the uncertainty of the state evolution, "
+                    "which accumulates over the horizon",
+                    _key(f"NBO relative RMSE, H = {h_hi} − H = {h_lo}", g),
+                    rule.verdict(_facts(g)),
+                    rule.text(),
+                    measured=f"{g.n} belief states; relative RMSE {fmt(100 * g.lo_value, 3)}% "
+                    f"at H = {h_lo}, {fmt(100 * g.hi_value, 3)}% at H = {h_hi}; difference "
+                    f"{fmt(p.mean, 3, True)} pp {fmt_ci(p.low, p.high, 3, True)}",
+                    part="beyond",
+                    setup=setup,
+                )
+            )
+        if tree and mc and {tree, mc} <= present:
+            d = rmse_growth(approx, model, tree, h_lo, h_hi, seed, n_boot, minus=mc)
+            g_mc = rmse_growth(approx, model, mc, h_lo, h_hi, seed, n_boot)
+            rule = hz2_rule(tree, mc, h_lo, h_hi)
+            out.append(
+                Claim(
+                    f"HZ-2-{model}",
+                    f"On '{model}', the error of {method_label(tree)} grows with the horizon "
+                    f"more than that of {method_label(mc)} (as many trajectories)",
+                    src + "Sec. II proposes pruning to keep the tree's N^H trajectories "
+                    "tractable as H grows",
+                    _key(
+                        f"RMSE growth H = {h_lo} → {h_hi}, {method_label(tree)} − "
+                        f"{method_label(mc)}",
+                        d,
+                    ),
+                    rule.verdict(_facts(d)),
+                    rule.text(),
+                    measured=f"{d.n} belief states; relative RMSE of {method_label(tree)} "
+                    f"{fmt(100 * d.lo_value, 3)}% → {fmt(100 * d.hi_value, 3)}%, of "
+                    f"{method_label(mc)} {fmt(100 * g_mc.lo_value, 3)}% → "
+                    f"{fmt(100 * g_mc.hi_value, 3)}% (H = {h_lo} → {h_hi})",
+                    part="beyond",
+                    setup=setup,
+                )
+            )
+    return out

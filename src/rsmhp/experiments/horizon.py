@@ -1,0 +1,251 @@
+r"""UAV horizon study (the ``horizon`` config section): how each planner's cost approximation,
+its decisions and its planning time change with the horizon H.
+
+Per model variant (``decisions.uav.models`` by name) and horizon H, one job works at the
+belief states of closed-loop NBO runs ``0..runs-1`` at ``steps`` (the runs use the base
+horizon ``uav.planner.horizon``, so every H sees the same belief states) and computes:
+
+* **cost approximation**: at each state, ``plans`` candidate plans (controls uniform in the
+  normalised box [-1, 1]^{2H}, keyed on model, state and H) are scored by the *reference*
+  cost :math:`J_{ref}(u) = \frac1{n}\sum_{i=1}^{n} c_i(u)`, the mean over ``n_ref``
+  independent hypotheses of the planning cost :math:`c_i(u) = \sum_{j=1}^{H}\mathrm{tr}\,P_j`
+  (m²), with its standard error; and by every method's own estimate :math:`\hat J_m(u)`, the
+  weighted mean of :math:`c` over the method's hypotheses, drawn ``replicates`` times
+  (methods without randomness once). One row per (state, method, replicate, plan): the
+  estimate, the reference and its SE. Methods without hypotheses (a tree search) estimate no
+  cost of a given plan and have no rows here.
+* **decisions and compute**: every method plans once at each state with horizon H and is
+  scored exactly as the decision study scores
+  (:func:`rsmhp.experiments.decisions_uav.score_state`); its planning time is measured by a
+  second, timed plan call with its own stream after it (milliseconds, one thread).
+
+Random streams are keyed on (model, run, step, H, method, replicate): a row never depends on
+the other methods, horizons or models, so jobs can run in any order.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from threadpoolctl import threadpool_limits
+
+from rsmhp.contracts import Contract
+from rsmhp.experiments.decisions_uav import (
+    _REGRET_INTEGERS,
+    _REGRET_NULLABLE,
+    REGRET_COLUMNS,
+    BeliefState,
+    belief_states,
+    merge_variant,
+    score_state,
+)
+from rsmhp.experiments.frontier import variant
+from rsmhp.seeding import job_rng
+from rsmhp.uav import fused, methods, target
+from rsmhp.uav.methods import Method
+from rsmhp.uav.planner import Belief, PlanningProblem
+from rsmhp.uav.simulation import UAVSetup
+
+__all__ = [
+    "APPROX_COLUMNS",
+    "HORIZON_REGRET_COLUMNS",
+    "horizon_contracts",
+    "horizon_setup",
+    "run_horizon",
+]
+
+log = logging.getLogger(__name__)
+
+APPROX_COLUMNS = [
+    "model",
+    "H",
+    "run",
+    "step",
+    "method",
+    "family",
+    "replicate",
+    "plan",
+    "estimate",
+    "reference",
+    "reference_se",
+]
+
+#: the decision study's regret rows with the horizon and the measured planning time
+HORIZON_REGRET_COLUMNS = ["H", *REGRET_COLUMNS, "plan_ms"]
+
+
+def horizon_setup(uav: Mapping[str, Any], model: Mapping[str, Any], H: int) -> UAVSetup:
+    """The setup of model variant ``model`` with planning horizon ``H``."""
+    cfg = merge_variant(uav, model)
+    cfg["planner"] = {**cfg["planner"], "horizon": int(H)}
+    return UAVSetup.from_config(cfg)
+
+
+def _names(cfg: Mapping[str, Any]) -> dict[str, Method]:
+    return methods.from_config(cfg["methods"], "horizon.methods")
+
+
+def horizon_contracts(cfg: Mapping[str, Any], model: str, H: int) -> tuple[Contract, Contract]:
+    """What the rule ``horizon`` writes for (``model``, ``H``): the cost-approximation rows
+    (every state, method with hypotheses, replicate and plan) and the regret rows (every
+    state and method)."""
+    planners = _names(cfg)
+    states = [
+        (r, s) for r in range(int(cfg["runs"])) for s in sorted({int(k) for k in cfg["steps"]})
+    ]
+    approx_keys = [
+        (r, s, name, k, p)
+        for r, s in states
+        for name, m in planners.items()
+        if m.estimates_cost
+        for k in range(int(cfg["replicates"]) if m.uses_rng else 1)
+        for p in range(int(cfg["plans"]))
+    ]
+    approx = Contract(
+        rule="horizon",
+        columns=APPROX_COLUMNS,
+        text=("model", "method", "family"),
+        integer=("H", "run", "step", "replicate", "plan"),
+        keys=("run", "step", "method", "replicate", "plan"),
+        expected=pd.DataFrame(approx_keys, columns=["run", "step", "method", "replicate", "plan"]),
+        values={"model": model, "H": int(H)},
+    )
+    regret_keys = [(r, s, name) for r, s in states for name in planners]
+    regret = Contract(
+        rule="horizon",
+        columns=HORIZON_REGRET_COLUMNS,
+        text=("model", "method", "family"),
+        integer=("H", *_REGRET_INTEGERS),
+        nullable=_REGRET_NULLABLE,
+        keys=("run", "step", "method"),
+        expected=pd.DataFrame(regret_keys, columns=["run", "step", "method"]),
+        values={"model": model, "H": int(H)},
+    )
+    return approx, regret
+
+
+def _warm(state: BeliefState, H: int) -> np.ndarray:
+    """The state's warm start (the shifted previous plan, base horizon) cut or padded with
+    zeros to H steps."""
+    w = np.zeros((H, 2))
+    n = min(H, len(state.warm))
+    w[:n] = state.warm[:n]
+    return w
+
+
+def _approx_rows(
+    state: BeliefState,
+    setup: UAVSetup,
+    planners: Mapping[str, Method],
+    cfg: Mapping[str, Any],
+    seed: int,
+) -> list[dict[str, Any]]:
+    H = setup.planner.horizon
+    ident = {"model": state.model, "run": state.run, "step": state.step, "H": H}
+    n_ref, n_plans = int(cfg["n_ref"]), int(cfg["plans"])
+    ref_xy = target.sample_independent(
+        state.x_hat, state.P_hat, H, n_ref, setup.target, job_rng(seed, "horizon_ref", **ident)
+    )[..., :2]
+    args = (setup.uav, setup.target, setup.sensor, setup.planner)
+    plans = job_rng(seed, "horizon_plans", **ident).uniform(-1.0, 1.0, (n_plans, 2 * H))
+    ref = PlanningProblem(state.uav, state.P_hat, ref_xy, *args)
+    per_hyp = fused.covariance_traces(
+        state.P_hat,
+        np.stack([ref.path(x)[:, :2] for x in plans]),
+        ref_xy,
+        setup.target.dt,
+        setup.target.Q,
+        setup.sensor,
+    ).sum(axis=2)  # (plans, n_ref)
+    j_ref = per_hyp.mean(axis=1)
+    se_ref = per_hyp.std(axis=1, ddof=1) / np.sqrt(n_ref)
+    belief = Belief(state.uav, state.x_hat, state.P_hat)
+    rows = []
+    for name, m in planners.items():
+        if not m.estimates_cost:
+            continue
+        for k in range(int(cfg["replicates"]) if m.uses_rng else 1):
+            rng = job_rng(seed, "horizon_hyp", **ident, **m.job_key(), replicate=k)
+            hyp = m.hypotheses(belief, setup, rng)
+            est = PlanningProblem(
+                state.uav, state.P_hat, hyp.states[..., :2], *args, weights=hyp.weights
+            ).costs(plans)
+            rows += [
+                {
+                    "model": state.model,
+                    "H": H,
+                    "run": state.run,
+                    "step": state.step,
+                    "method": name,
+                    "family": m.family,
+                    "replicate": k,
+                    "plan": p,
+                    "estimate": float(est[p]),
+                    "reference": float(j_ref[p]),
+                    "reference_se": float(se_ref[p]),
+                }
+                for p in range(n_plans)
+            ]
+    return rows
+
+
+def _timed_plans(
+    state: BeliefState, setup: UAVSetup, planners: Mapping[str, Method], seed: int
+) -> dict[str, float]:
+    """Milliseconds of one plan call per method (its own stream; one thread)."""
+    H = setup.planner.horizon
+    belief = Belief(state.uav, state.x_hat, state.P_hat)
+    out = {}
+    for name, m in planners.items():
+        planner = m.planner(setup)
+        rng = job_rng(
+            seed, "horizon_timing", model=state.model, run=state.run, step=state.step, H=H,
+            **m.job_key(),
+        )  # fmt: skip
+        t0 = time.perf_counter()
+        planner.plan(belief, _warm(state, H), rng)
+        out[name] = 1e3 * (time.perf_counter() - t0)
+    return out
+
+
+def run_horizon(
+    uav: Mapping[str, Any],
+    models: Sequence[Mapping[str, Any]],
+    cfg: Mapping[str, Any],
+    scoring: Mapping[str, Any],
+    model: str,
+    H: int,
+    seed: int,
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The study for (``model``, ``H``) (module docstring): ``(cost-approximation rows,
+    APPROX_COLUMNS; regret rows, HORIZON_REGRET_COLUMNS)``. ``uav`` is the validated ``uav``
+    section, ``models`` ``decisions.uav.models``, ``cfg`` the ``horizon`` section,
+    ``scoring`` the decision study's scoring settings. Runs on one thread."""
+    var = variant(list(models), model)
+    base = horizon_setup(uav, var, int(uav["planner"]["horizon"]))
+    setup = horizon_setup(uav, var, H)
+    planners = _names(cfg)
+    with threadpool_limits(limits=1):
+        states = belief_states(base, model, seed, range(int(cfg["runs"])), cfg["steps"])
+        log.info("horizon %s H=%d: %d belief states x %d methods", model, H, len(states),
+                 len(planners))  # fmt: skip
+        approx, regret = [], []
+        for i, st in enumerate(states):
+            h_state = BeliefState(st.model, st.run, st.step, st.uav, st.x_hat, st.P_hat,
+                                  _warm(st, H))  # fmt: skip
+            approx += _approx_rows(h_state, setup, planners, cfg, seed)
+            scored = score_state(h_state, setup, planners, scoring, seed)
+            # timed after the scored plans: no first-call (compilation, cache) cost is timed
+            ms = _timed_plans(h_state, setup, planners, seed)
+            for row in scored:
+                regret.append({"H": int(H), **row, "plan_ms": ms[row["method"]]})
+            log.info("horizon %s H=%d: state %d/%d done", model, H, i + 1, len(states))
+    return (
+        pd.DataFrame(approx, columns=APPROX_COLUMNS),
+        pd.DataFrame(regret, columns=HORIZON_REGRET_COLUMNS),
+    )

@@ -1,0 +1,102 @@
+r"""The UAV horizon study: cost-approximation error, planning time and regret against H.
+
+``hz_uav_error``: columns are model variants; top row the relative RMSE of each method's cost
+estimate (%, log scale, noise-corrected; 95% bootstrap CIs over belief states), bottom row
+its relative bias (%). ``hz_uav_time``: top row the median planning milliseconds per step
+(log scale), bottom row the open-loop regret against the best of the methods' plans (% of the
+best cost: the part of the regret due to the cost approximation). x: the horizon H (log
+scale). One line per method in its palette colour.
+"""
+
+from __future__ import annotations
+
+import matplotlib.pyplot as plt
+import numpy as np
+import pandas as pd
+from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
+
+from rsmhp.figures import theme
+from rsmhp.palette import method_colour, method_label
+from rsmhp.uav import methods as _registry  # noqa: F401  (UAV method names get their colours)
+
+__all__ = ["FIGURES", "horizon_error_figure", "horizon_time_figure"]
+
+FIGURES = ["hz_uav_error", "hz_uav_time"]
+
+#: relative RMSEs below this (%) are drawn at it (the log axis has no 0)
+RMSE_FLOOR_PCT = 1e-3
+
+
+def _h_axis(ax, hs) -> None:
+    ax.set_xscale("log")
+    ax.xaxis.set_major_locator(FixedLocator(sorted(hs)))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.xaxis.set_minor_formatter(NullFormatter())
+
+
+def _grid(summary: pd.DataFrame, rows, title: str) -> plt.Figure:
+    theme()
+    models = list(dict.fromkeys(summary["model"]))
+    if not models:
+        raise ValueError("horizon summary is empty")
+    hs = sorted(int(h) for h in summary["H"].unique())
+    fig, axes = plt.subplots(
+        len(rows), len(models), figsize=(4.8 * len(models), 3.4 * len(rows)), squeeze=False,
+        sharex=True,
+    )  # fmt: skip
+    for j, model in enumerate(models):
+        s = summary[summary["model"] == model]
+        for i, (col, label, log, floor) in enumerate(rows):
+            ax = axes[i, j]
+            for method, g in s.groupby("method", sort=False):
+                g = g.sort_values("H")
+                y = g[col].to_numpy(float)
+                if floor is not None:
+                    y = np.maximum(y, floor)
+                kw = {"color": method_colour(method), "marker": "o", "ms": 3.5, "lw": 1.3}
+                if f"{col}_low" in g:
+                    lo = np.maximum(g[f"{col}_low"].to_numpy(float), floor or -np.inf)
+                    hi = np.maximum(g[f"{col}_high"].to_numpy(float), floor or -np.inf)
+                    ax.errorbar(g["H"], y, yerr=np.vstack([np.maximum(y - lo, 0),
+                                np.maximum(hi - y, 0)]), capsize=2, label=method_label(method),
+                                **kw)  # fmt: skip
+                else:
+                    ax.plot(g["H"], y, label=method_label(method), **kw)
+            if log:
+                ax.set_yscale("log")
+            else:
+                ax.axhline(0.0, color="0.4", lw=0.8)
+            _h_axis(ax, hs)
+            if i == 0:
+                ax.set_title(model)
+            if i == len(rows) - 1:
+                ax.set_xlabel("horizon H (steps)")
+            if j == 0:
+                ax.set_ylabel(label)
+    axes[0, -1].legend(fontsize="x-small", loc="best")
+    fig.suptitle(title, fontsize=11)
+    fig.tight_layout()
+    return fig
+
+
+def horizon_error_figure(approx_summary: pd.DataFrame) -> plt.Figure:
+    """``hz_uav_error`` from :func:`rsmhp.analysis.horizon.summarize_approx` (module doc)."""
+    s = approx_summary.copy()
+    for c in ("rel_rmse", "rel_rmse_low", "rel_rmse_high", "rel_bias", "rel_bias_low",
+              "rel_bias_high"):  # fmt: skip
+        s[c] = 100 * s[c]
+    rows = [
+        ("rel_rmse", "relative RMSE of the cost estimate (%)", True, RMSE_FLOOR_PCT),
+        ("rel_bias", "relative bias (%)", False, None),
+    ]
+    return _grid(s, rows, "Cost approximation against the reference, by horizon")
+
+
+def horizon_time_figure(regret_summary: pd.DataFrame) -> plt.Figure:
+    """``hz_uav_time`` from :func:`rsmhp.analysis.horizon.summarize_horizon_regret`."""
+    rows = [
+        ("plan_ms", "planning ms per step (median)", True, None),
+        ("regret_methods_pct", "regret vs the methods' best plan (%)", False, None),
+    ]
+    return _grid(regret_summary, rows, "Planning time and decisions, by horizon")

@@ -1,0 +1,179 @@
+"""UAV horizon study, report section (order 33, "Long horizons"): the Markdown tables of the
+cost approximation and of regret and time by horizon, a short body (setting, findings,
+figures) and the appendix, from :mod:`rsmhp.analysis.horizon` and the claims of
+:mod:`rsmhp.claims.horizon`. Every number is read from the tables or the claims."""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from rsmhp.claims.horizon import horizon_claims
+from rsmhp.figures.horizon import FIGURES
+from rsmhp.ledger import Claim, Section
+from rsmhp.markdown import fmt, fmt_ci, markdown_table
+from rsmhp.palette import method_label
+
+__all__ = ["FIGURES", "TABLES", "horizon_section", "horizon_tables"]
+
+TABLES = ("hz_uav_approx", "hz_uav_regret")
+
+
+def _ci(lo: pd.Series, hi: pd.Series) -> list[str]:
+    return [
+        fmt_ci(100 * a, 100 * b, 3) if np.isfinite(a) and np.isfinite(b) else "undefined"
+        for a, b in zip(lo, hi, strict=True)
+    ]
+
+
+def horizon_tables(approx_summary: pd.DataFrame, regret_summary: pd.DataFrame) -> dict[str, str]:
+    """Markdown tables ``hz_uav_approx`` (per model, H and method: relative bias and RMSE of
+    the cost estimate in percent with CIs, the reference's relative SE, rank correlation) and
+    ``hz_uav_regret`` (relative regret, its part due to the approximation, planning ms)."""
+    a = approx_summary
+    t1 = pd.DataFrame(
+        {
+            "model": a["model"],
+            "H": a["H"].astype(int),
+            "method": a["method"].map(method_label),
+            "states": a["states"].astype(int),
+            "bias %": 100 * a["rel_bias"],
+            "95% CI": _ci(a["rel_bias_low"], a["rel_bias_high"]),
+            "RMSE %": 100 * a["rel_rmse"],
+            "95% CI ": _ci(a["rel_rmse_low"], a["rel_rmse_high"]),
+            "reference SE %": 100 * a["ref_noise"],
+            "Spearman": a["spearman"],
+            "constant": a["spearman_undefined"].astype(int),
+        }
+    )
+    r = regret_summary
+    t2 = pd.DataFrame(
+        {
+            "model": r["model"],
+            "H": r["H"].astype(int),
+            "method": r["method"].map(method_label),
+            "states": r["states"].astype(int),
+            "regret %": r["regret_pct"],
+            "vs methods' best %": r["regret_methods_pct"],
+            "ms/step": r["plan_ms"],
+        }
+    )
+    return {
+        "hz_uav_approx": markdown_table(t1, digits=3, missing="undefined", signed=("bias %",)),
+        "hz_uav_regret": markdown_table(t2, digits=3),
+    }
+
+
+def _setting(cfg: Mapping[str, Any], hs: Sequence[int]) -> str:
+    steps = ", ".join(str(int(s)) for s in cfg["steps"])
+    return (
+        f"Horizons H ∈ {{{', '.join(str(h) for h in hs)}}} on "
+        f"{', '.join(repr(m) for m in cfg['models'])}, at the belief states of "
+        f"{int(cfg['runs'])} closed-loop NBO runs (steps {steps}; the same states at every H). "
+        f"**Cost approximation**: at each state, {int(cfg['plans'])} random plans; each "
+        "method's estimate of a plan's cost (Σ tr P over the horizon) against a reference of "
+        f"{int(cfg['n_ref'])} independent hypotheses; random methods drawn "
+        f"{int(cfg['replicates'])} times. Relative RMSE is noise-corrected (the reference's "
+        "own variance subtracted), with 95% bootstrap CIs over belief states. **Decisions and "
+        "time**: every method plans once at each state and is scored as in the decision study; "
+        "planning milliseconds per step from a second, timed plan call (one thread). The tree "
+        "search has no estimate of a given plan's cost: it appears in regret and time only."
+    )
+
+
+def _findings(claims: Sequence[Claim], a: pd.DataFrame, r: pd.DataFrame) -> str:
+    out = []
+    for c in claims:
+        k = c.key
+        out.append(
+            f"{c.id}: {fmt(k.value, k.digits, True)} pp "
+            f"{fmt_ci(k.ci_low, k.ci_high, k.digits, True)} "
+            f"({c.verdict}; {c.measured.split('; ', 1)[1]})."
+        )
+    hs = sorted(int(h) for h in a["H"].unique())
+    h_hi = hs[-1]
+    for model, s in a[a["H"] == h_hi].groupby("model", sort=False):
+        ranked = s.sort_values("rel_rmse")
+        out.append(
+            f"At H = {h_hi} on '{model}' the relative RMSE runs from "
+            + ", ".join(
+                f"{method_label(m)} "
+                + (f"{fmt(100 * v, 2)}%" if v > 0 else "below the reference's noise")
+                for m, v in zip(ranked["method"], ranked["rel_rmse"], strict=True)
+            )
+            + "."
+        )
+    for model, s in r[r["H"] == h_hi].groupby("model", sort=False):
+        out.append(
+            f"Planning at H = {h_hi} on '{model}' takes "
+            + ", ".join(
+                f"{method_label(m)} {fmt(v, 2)} ms"
+                for m, v in zip(s["method"], s["plan_ms"], strict=True)
+            )
+            + f" per step; mean relative regret {fmt(s['regret_pct'].min(), 3)}% to "
+            f"{fmt(s['regret_pct'].max(), 3)}%, of which the part against the methods' best "
+            f"plan is {fmt(s['regret_methods_pct'].min(), 3)}% to "
+            f"{fmt(s['regret_methods_pct'].max(), 3)}%; the rest is shared by every method: "
+            f"the common optimiser budget on {2 * h_hi} controls stops before the best plan "
+            "found by the longer multi-start."
+        )
+    return " ".join(out)
+
+
+_FIGURE = [
+    "![Cost approximation by horizon](figures/hz_uav_error.png)",
+    "",
+    "*Relative RMSE (log scale, noise-corrected) and bias of each method's cost estimate "
+    "against the reference, by horizon; bars: 95% bootstrap CIs over belief states.*",
+    "",
+    "![Planning time and regret by horizon](figures/hz_uav_time.png)",
+    "",
+    "*Median planning ms per step (log scale) and the open-loop regret against the best of "
+    "the methods' plans (%), by horizon.*",
+]
+
+
+def horizon_section(
+    approx: pd.DataFrame,
+    approx_summary: pd.DataFrame,
+    regret_summary: pd.DataFrame,
+    tables: Mapping[str, str],
+    cfg: Mapping[str, Any],
+    seed: int,
+) -> Section:
+    """The horizon study's report section (order 33); ``cfg`` is ``horizon.uav``."""
+    claims = horizon_claims(approx, approx_summary, cfg, seed)
+    hs = sorted(int(h) for h in cfg["H"])
+    body = "\n".join(
+        [_setting(cfg, hs), "", _findings(claims, approx_summary, regret_summary), "", *_FIGURE]
+    )
+    appendix = "\n".join(
+        [
+            "Cost approximation per model, horizon and method (relative bias and RMSE of the "
+            "cost estimate in percent of the reference cost, 95% bootstrap CIs over belief "
+            "states; 'reference SE': the reference's own relative standard error, already "
+            "subtracted from the RMSE; Spearman: rank correlation of estimate and reference "
+            "over the plans, mean over states and replicates; 'constant': (state, replicate) "
+            "pairs where the estimate does not change over the plans, left out of it):",
+            "",
+            tables["hz_uav_approx"],
+            "",
+            "Open-loop regret (percent of the best plan found) and planning time per model, "
+            "horizon and method ('vs methods' best': against the best of the methods' plans, "
+            "the part due to the cost approximation):",
+            "",
+            tables["hz_uav_regret"],
+        ]
+    )
+    return Section(
+        key="horizon_uav",
+        title="Long horizons: UAV cost approximation, decisions and time",
+        order=33,
+        body=body,
+        claims=claims,
+        figures=list(FIGURES),
+        appendix=appendix,
+    )

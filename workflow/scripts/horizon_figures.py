@@ -1,0 +1,16 @@
+"""Rule horizon_figures: the UAV horizon study's figures (PNG + PDF)."""
+
+from pathlib import Path
+
+from rsmhp.analysis.horizon import APPROX_SUMMARY_COLUMNS, REGRET_SUMMARY_COLUMNS
+from rsmhp.figures import save_figure
+from rsmhp.figures.horizon import horizon_error_figure, horizon_time_figure
+from rsmhp.io import read_table
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake):
+    outdir = Path(snakemake.output[0]).parent
+    approx = read_table(snakemake.input.approx, APPROX_SUMMARY_COLUMNS)
+    regret = read_table(snakemake.input.regret, REGRET_SUMMARY_COLUMNS)
+    save_figure(horizon_error_figure(approx), outdir / "hz_uav_error")
+    save_figure(horizon_time_figure(regret), outdir / "hz_uav_time")

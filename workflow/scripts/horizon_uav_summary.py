@@ -1,0 +1,35 @@
+"""Rule horizon_uav_summary: statistics of the UAV horizon study, tables, claims, section."""
+
+from pathlib import Path
+
+import pandas as pd
+
+from rsmhp.analysis.horizon import summarize_approx, summarize_horizon_regret
+from rsmhp.contracts import read_checked
+from rsmhp.experiments.horizon import horizon_contracts
+from rsmhp.io import write_csv, write_text
+from rsmhp.narrative.horizon import horizon_section, horizon_tables
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake) as log:
+    p = snakemake.params
+    jobs = [(m, int(h)) for m in p.cfg["models"] for h in p.cfg["H"]]
+    approx, regret = [], []
+    for (model, H), a_path, r_path in zip(
+        jobs, snakemake.input.approx, snakemake.input.regret, strict=True
+    ):
+        c_approx, c_regret = horizon_contracts(p.cfg, model, H)
+        approx.append(read_checked(a_path, c_approx))
+        regret.append(read_checked(r_path, c_regret))
+    approx = pd.concat(approx, ignore_index=True)
+    regret = pd.concat(regret, ignore_index=True)
+    a_sum = summarize_approx(approx, p.seed, int(p.cfg["bootstrap"]))
+    r_sum = summarize_horizon_regret(regret)
+    tables = horizon_tables(a_sum, r_sum)
+    section = horizon_section(approx, a_sum, r_sum, tables, p.cfg, p.seed)
+    write_csv(a_sum, snakemake.output.approx)
+    write_csv(r_sum, snakemake.output.regret)
+    for path in snakemake.output.tables:
+        write_text(tables[Path(path).stem] + "\n", path)
+    section.save(snakemake.output.section)
+    log.info("%d approximation rows, %d claims", len(a_sum), len(section.claims))
