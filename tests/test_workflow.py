@@ -355,6 +355,32 @@ def test_frontier_outputs(run_j2, tiny):
         assert text.strip() and text.strip() in appendix
 
 
+def test_horizon_outputs(run_j2, tiny):
+    """The UAV horizon study: one job per (model, H) with every method's cost-approximation
+    rows (none for the tree search) and regret rows, the summaries, claims HZ-1/HZ-2 per
+    model in the report, figures and tables."""
+    cfg = tiny["horizon"]["uav"]
+    for model in cfg["models"]:
+        for H in cfg["H"]:
+            a = pd.read_csv(run_j2 / f"results/horizon/uav/{model}_H{H}_approx.csv")
+            r = pd.read_csv(run_j2 / f"results/horizon/uav/{model}_H{H}_regret.csv")
+            assert set(a["H"]) == set(r["H"]) == {H}
+            assert "dpw_s20" in set(r["method"]) and "dpw_s20" not in set(a["method"])
+            assert (r["plan_ms"] > 0).all()
+    summary = pd.read_csv(run_j2 / "results/horizon/uav_approx_summary.csv")
+    assert set(summary["H"]) == set(cfg["H"]) and (summary["rel_rmse"] >= 0).all()
+    report = (run_j2 / "results/paper/replication.md").read_text()
+    assert report.index("## Planners at equal compute") < report.index("## Long horizons")
+    for model in cfg["models"]:
+        for cid in (f"HZ-1-{model}", f"HZ-2-{model}"):
+            assert f"| {cid} |" in report
+    for name in ("hz_uav_error", "hz_uav_time"):
+        assert (run_j2 / f"results/paper/figures/{name}.png").read_bytes()[:4] == b"\x89PNG"
+    appendix = (run_j2 / "results/paper/appendix.md").read_text()
+    for table in ("hz_uav_approx", "hz_uav_regret"):
+        assert (run_j2 / f"results/tables/{table}.md").read_text().strip() in appendix
+
+
 def test_frontier_recording_replays_the_run_its_rule_chooses(run_j2, tiny):
     """decisions.recording: NBO and every budget member, in the run chosen by `select` from
     the frontier's paired differences (the log says which; the replay equals the table)."""
@@ -457,8 +483,9 @@ def test_slurm_profile_plans_every_rule(tmp_path):
         for line in out.splitlines()
         if line.startswith(("rule ", "localrule "))
     }
-    # the default target plans every rule except the five study-level target rules and verify
-    assert planned == every - {"lqg", "estimators", "uav", "decisions", "frontier", "verify"}
+    # the default target plans every rule except the six study-level target rules and verify
+    targets = {"lqg", "estimators", "uav", "decisions", "frontier", "horizon", "verify"}
+    assert planned == every - targets
     profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
     assert profile["executor"] == "slurm"
     block = out.split("rule estimators_ablation:", 1)[1].split("\n\n", 1)[0]
@@ -476,7 +503,7 @@ def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, 
     captions = sorted((ROOT / "workflow/report").glob("*.rst"))
     figures = [p.stem for p in (run_j2 / "results/figures").glob("*.png")]
     tables = [p.stem for p in (run_j2 / "results/tables").glob("*.md")]
-    assert len(figures) == 18 and len(tables) == 18
+    assert len(figures) == 20 and len(tables) == 20
     assert {c.stem for c in captions} == set(figures) | {f"table_{t}" for t in tables}
     for name in figures:
         assert f"{name}.png" in html, name

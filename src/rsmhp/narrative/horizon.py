@@ -68,19 +68,17 @@ def horizon_tables(approx_summary: pd.DataFrame, regret_summary: pd.DataFrame) -
 
 
 def _setting(cfg: Mapping[str, Any], hs: Sequence[int]) -> str:
-    steps = ", ".join(str(int(s)) for s in cfg["steps"])
     return (
-        f"Horizons H ∈ {{{', '.join(str(h) for h in hs)}}} on "
+        f"H ∈ {{{', '.join(str(h) for h in hs)}}} on "
         f"{', '.join(repr(m) for m in cfg['models'])}, at the belief states of "
-        f"{int(cfg['runs'])} closed-loop NBO runs (steps {steps}; the same states at every H). "
-        f"**Cost approximation**: at each state, {int(cfg['plans'])} random plans; each "
-        "method's estimate of a plan's cost (Σ tr P over the horizon) against a reference of "
-        f"{int(cfg['n_ref'])} independent hypotheses; random methods drawn "
-        f"{int(cfg['replicates'])} times. Relative RMSE is noise-corrected (the reference's "
-        "own variance subtracted), with 95% bootstrap CIs over belief states. **Decisions and "
-        "time**: every method plans once at each state and is scored as in the decision study; "
-        "planning milliseconds per step from a second, timed plan call (one thread). The tree "
-        "search has no estimate of a given plan's cost: it appears in regret and time only."
+        f"{int(cfg['runs'])} NBO runs (the same at every H). **Cost approximation**: each "
+        f"method's estimate of the cost (Σ tr P) of {int(cfg['plans'])} random plans per state "
+        f"against a reference of {int(cfg['n_ref'])} independent hypotheses (random methods "
+        f"drawn {int(cfg['replicates'])} times); relative RMSE noise-corrected (the "
+        "reference's variance subtracted), 95% bootstrap CIs over states. **Decisions and "
+        "time**: each method plans once per state, scored as in the decision study, and is "
+        "timed on a second plan call (one thread). The tree search estimates no given plan's "
+        "cost: regret and time only."
     )
 
 
@@ -89,36 +87,25 @@ def _findings(claims: Sequence[Claim], a: pd.DataFrame, r: pd.DataFrame) -> str:
     for c in claims:
         k = c.key
         out.append(
-            f"{c.id}: {fmt(k.value, k.digits, True)} pp "
-            f"{fmt_ci(k.ci_low, k.ci_high, k.digits, True)} "
-            f"({c.verdict}; {c.measured.split('; ', 1)[1]})."
+            f"{c.id} ({c.verdict}): {k.name} {fmt(k.value, k.digits, True)} pp "
+            f"{fmt_ci(k.ci_low, k.ci_high, k.digits, True)}."
         )
-    hs = sorted(int(h) for h in a["H"].unique())
-    h_hi = hs[-1]
+    h_hi = max(int(h) for h in a["H"].unique())
     for model, s in a[a["H"] == h_hi].groupby("model", sort=False):
         ranked = s.sort_values("rel_rmse")
+        t = r[(r["H"] == h_hi) & (r["model"] == model)]
         out.append(
-            f"At H = {h_hi} on '{model}' the relative RMSE runs from "
+            f"At H = {h_hi} on '{model}', relative RMSE: "
             + ", ".join(
                 f"{method_label(m)} "
                 + (f"{fmt(100 * v, 2)}%" if v > 0 else "below the reference's noise")
                 for m, v in zip(ranked["method"], ranked["rel_rmse"], strict=True)
             )
-            + "."
-        )
-    for model, s in r[r["H"] == h_hi].groupby("model", sort=False):
-        out.append(
-            f"Planning at H = {h_hi} on '{model}' takes "
-            + ", ".join(
-                f"{method_label(m)} {fmt(v, 2)} ms"
-                for m, v in zip(s["method"], s["plan_ms"], strict=True)
-            )
-            + f" per step; mean relative regret {fmt(s['regret_pct'].min(), 3)}% to "
-            f"{fmt(s['regret_pct'].max(), 3)}%, of which the part against the methods' best "
-            f"plan is {fmt(s['regret_methods_pct'].min(), 3)}% to "
-            f"{fmt(s['regret_methods_pct'].max(), 3)}%; the rest is shared by every method: "
-            f"the common optimiser budget on {2 * h_hi} controls stops before the best plan "
-            "found by the longer multi-start."
+            + f"; planning {fmt(t['plan_ms'].min(), 2)} to {fmt(t['plan_ms'].max(), 2)} ms per "
+            f"step; regret against the methods' best plan {fmt(t['regret_methods_pct'].min(), 2)}"
+            f"% to {fmt(t['regret_methods_pct'].max(), 2)}% (against the best plan found "
+            f"{fmt(t['regret_pct'].min(), 2)}% to {fmt(t['regret_pct'].max(), 2)}%: the common "
+            f"optimiser budget stops early on {2 * h_hi} controls)."
         )
     return " ".join(out)
 

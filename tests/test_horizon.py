@@ -1,0 +1,219 @@
+"""UAV horizon study (rsmhp.experiments.horizon, rsmhp.analysis.horizon, rsmhp.claims.horizon).
+
+Oracles: a method's estimate is its planning cost on its own hypotheses (PlanningProblem on
+the hypotheses it draws with the row's stream); the reference is the mean of the per-hypothesis
+costs (fused.covariance_traces); NBO's and the sigma points' estimates do not depend on the
+replicate; the noise-corrected RMSE against a hand computation and, statistically, against a
+known error variance; growth and claims against their rules on tables with known errors.
+"""
+
+from __future__ import annotations
+
+import copy
+import re
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from rsmhp.analysis.horizon import rmse_growth, state_errors, summarize_approx
+from rsmhp.contracts import check_table
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+MODELS = [{"name": "paper"}, {"name": "footprint150", "sensor": {"footprint_radius": 150.0}}]
+SCORING = {"n_eval": 200, "polish": 1, "random_starts": 1, "eval_maxiter": 10, "n_random": 20}
+HZ = {
+    "runs": 1,
+    "steps": [0, 3],
+    "plans": 5,
+    "n_ref": 3000,
+    "replicates": 3,
+    "bootstrap": 500,
+    "methods": {
+        "nbo": True,
+        "rsmhp_nt": [16],
+        "sigma": True,
+        "tree": [{"N": 2, "M": 8}],
+        "dpw": [{"sims": 20}],
+    },
+}
+
+
+def _uav() -> dict:
+    cfg = copy.deepcopy(CONFIG["uav"])
+    cfg["scenario"]["steps"] = 5
+    cfg["planner"].update(horizon=3, maxiter=6, maxfun=12)
+    return cfg
+
+
+@pytest.fixture(scope="module")
+def paper_h4():
+    from rsmhp.experiments.horizon import run_horizon
+
+    return run_horizon(_uav(), MODELS, HZ, SCORING, "paper", 4, 5)
+
+
+def test_rows_follow_the_contracts(paper_h4):
+    from rsmhp.experiments.horizon import horizon_contracts
+
+    approx, regret = paper_h4
+    c_a, c_r = horizon_contracts(HZ, "paper", 4)
+    check_table(approx, "approx", c_a)
+    check_table(regret, "regret", c_r)
+    # the tree search estimates no given plan's cost: regret and time only
+    assert "dpw_s20" not in set(approx["method"]) and "dpw_s20" in set(regret["method"])
+    assert (regret["plan_ms"] > 0).all()
+    # deterministic methods once, random ones `replicates` times
+    reps = approx.groupby("method")["replicate"].nunique()
+    assert reps["nbo"] == 1 and reps["sigma"] == 1 and reps["rsmhp_nt16"] == 3
+
+
+def test_estimates_and_reference_against_the_planning_cost(paper_h4):
+    """Row oracle: recompute one state's reference and each method's estimate from scratch."""
+    from rsmhp.experiments.decisions_uav import belief_states
+    from rsmhp.experiments.horizon import horizon_setup
+    from rsmhp.seeding import job_rng
+    from rsmhp.uav import fused, methods, target
+    from rsmhp.uav.planner import Belief, PlanningProblem
+
+    approx, _ = paper_h4
+    base = horizon_setup(_uav(), MODELS[0], 3)
+    setup = horizon_setup(_uav(), MODELS[0], 4)
+    st = belief_states(base, "paper", 5, [0], [3])[0]
+    ident = {"model": "paper", "run": 0, "step": 3, "H": 4}
+    ref_xy = target.sample_independent(
+        st.x_hat, st.P_hat, 4, HZ["n_ref"], setup.target, job_rng(5, "horizon_ref", **ident)
+    )[..., :2]
+    plans = job_rng(5, "horizon_plans", **ident).uniform(-1.0, 1.0, (HZ["plans"], 8))
+    args = (setup.uav, setup.target, setup.sensor, setup.planner)
+    ref = PlanningProblem(st.uav, st.P_hat, ref_xy, *args)
+    per = fused.covariance_traces(
+        st.P_hat, np.stack([ref.path(x)[:, :2] for x in plans]), ref_xy, setup.target.dt,
+        setup.target.Q, setup.sensor,
+    ).sum(axis=2)  # fmt: skip
+    rows = approx[(approx["step"] == 3)]
+    np.testing.assert_allclose(
+        rows[rows["method"] == "nbo"].sort_values("plan")["reference"], per.mean(axis=1),
+        rtol=1e-12,
+    )  # fmt: skip
+    np.testing.assert_allclose(ref.costs(plans), per.mean(axis=1), rtol=1e-9)
+    belief = Belief(st.uav, st.x_hat, st.P_hat)
+    for name in ("nbo", "rsmhp_nt16", "sigma", "tree_n2_m8"):
+        m = methods.from_name(name)
+        rng = job_rng(5, "horizon_hyp", **ident, **m.job_key(), replicate=0)
+        hyp = m.hypotheses(belief, setup, rng)
+        want = PlanningProblem(
+            st.uav, st.P_hat, hyp.states[..., :2], *args, weights=hyp.weights
+        ).costs(plans)
+        got = rows[(rows["method"] == name) & (rows["replicate"] == 0)].sort_values("plan")
+        np.testing.assert_allclose(got["estimate"], want, rtol=1e-12, err_msg=name)
+
+
+def _table(errors: dict[str, np.ndarray], se: float = 0.0, H: int = 2) -> pd.DataFrame:
+    """Approximation rows of model 'm' at horizon H: per method, estimate = reference x (1 +
+    e) with e[state, plan] given, reference 100, reference SE ``se`` x 100."""
+    rows = []
+    for method, e in errors.items():
+        for s in range(e.shape[0]):
+            for p in range(e.shape[1]):
+                rows.append({"model": "m", "H": H, "run": s, "step": 0, "method": method,
+                             "family": method.split("_")[0], "replicate": 0, "plan": p,
+                             "estimate": 100.0 * (1 + e[s, p]), "reference": 100.0,
+                             "reference_se": 100.0 * se})  # fmt: skip
+    return pd.DataFrame(rows)
+
+
+def test_bias_and_noise_corrected_rmse_by_hand():
+    e = np.array([[0.01, 0.03], [-0.02, 0.02], [0.0, 0.04]])
+    s = summarize_approx(_table({"a_1": e}, se=0.01), seed=1, n_boot=400).iloc[0]
+    assert s["rel_bias"] == pytest.approx(e.mean())
+    assert s["rel_rmse"] == pytest.approx(np.sqrt((e**2).mean() - 0.01**2))
+    assert s["ref_noise"] == pytest.approx(0.01)
+    assert s["rel_rmse_low"] <= s["rel_rmse"] <= s["rel_rmse_high"]
+    per = state_errors(_table({"a_1": e}, se=0.01))
+    np.testing.assert_allclose(per["b"], e.mean(axis=1))
+    np.testing.assert_allclose(per["q"], (e**2).mean(axis=1) - 1e-4)
+
+
+def test_noise_correction_recovers_a_known_error_sd():
+    """An unbiased estimator with relative error sd 2% scored against a reference with
+    relative SE 3% (both normal): the raw RMS error is sqrt(2² + 3²) = 3.6%, the corrected one
+    2%. Tolerance from the variance: e is about normal with variance v = 0.02² + 0.03² =
+    1.3e-3, so Var(e²) = 2 v² and the mean square over n = 100000 pairs has sd
+    sqrt(2 v² / n) = 5.8e-6, i.e. 5.8e-6 / (2 × 0.02) = 1.5e-4 on the RMSE; 5 sd plus the
+    second-order bias of dividing by a noisy reference (about 3 × 0.03² × v / (2 × 0.02) =
+    9e-5) gives 8.2e-4."""
+    rng = np.random.default_rng(11)
+    n_states, n_plans = 400, 250
+    est_err = rng.normal(0.0, 0.02, (n_states, n_plans))
+    ref_err = rng.normal(0.0, 0.03, (n_states, n_plans))
+    df = _table({"a_1": est_err}, se=0.03)
+    df["reference"] = 100.0 * (1 + ref_err.ravel())
+    df["estimate"] = 100.0 * (1 + est_err.ravel())
+    df["reference_se"] = 0.03 * df["reference"]
+    s = summarize_approx(df, seed=1, n_boot=200).iloc[0]
+    assert s["rel_rmse"] == pytest.approx(0.02, abs=8.2e-4)
+    raw = np.sqrt((((df["estimate"] - df["reference"]) / df["reference"]) ** 2).mean())
+    assert raw == pytest.approx(np.hypot(0.02, 0.03), abs=1e-3)
+
+
+def test_growth_and_its_difference_between_methods():
+    rng = np.random.default_rng(3)
+    lo = {"tree_x": rng.normal(0, 0.01, (30, 8)), "mc_x": rng.normal(0, 0.01, (30, 8))}
+    hi = {"tree_x": rng.normal(0, 0.05, (30, 8)), "mc_x": rng.normal(0, 0.012, (30, 8))}
+    df = pd.concat([_table(lo, H=2), _table(hi, H=24)], ignore_index=True)
+    g = rmse_growth(df, "m", "tree_x", 2, 24, seed=1, n_boot=1000)
+    want = np.sqrt((hi["tree_x"] ** 2).mean()) - np.sqrt((lo["tree_x"] ** 2).mean())
+    assert g.mean == pytest.approx(want) and g.low > 0 and g.n == 30
+    d = rmse_growth(df, "m", "tree_x", 2, 24, seed=1, n_boot=1000, minus="mc_x")
+    want_mc = np.sqrt((hi["mc_x"] ** 2).mean()) - np.sqrt((lo["mc_x"] ** 2).mean())
+    assert d.mean == pytest.approx(want - want_mc) and d.low > 0
+    with pytest.raises(ValueError, match="H = 12 has no cost-approximation rows"):
+        rmse_growth(df, "m", "tree_x", 2, 12, seed=1, n_boot=100)
+
+
+def test_claims_follow_their_rules():
+    from rsmhp.claims.horizon import KEY, horizon_claims, hz1_rule, hz2_rule
+
+    rng = np.random.default_rng(4)
+    lo = {m: rng.normal(0, 0.01, (25, 6)) for m in ("nbo", "tree_n4_m256", "rsmhp_nt256")}
+    hi = {"nbo": rng.normal(0.02, 0.03, (25, 6)), "tree_n4_m256": rng.normal(0, 0.01, (25, 6)),
+          "rsmhp_nt256": rng.normal(0, 0.04, (25, 6))}  # fmt: skip
+    df = pd.concat([_table(lo, H=2), _table(hi, H=24)], ignore_index=True)
+    df["family"] = df["method"].map({"nbo": "nbo", "tree_n4_m256": "tree", "rsmhp_nt256": "rsmhp"})
+    summary = summarize_approx(df, seed=1, n_boot=300)
+    cfg = {"bootstrap": 1000, "claims": {"tree": "tree_n4_m256", "monte_carlo": "rsmhp_nt256"}}
+    claims = {c.id: c for c in horizon_claims(df, summary, cfg, seed=2)}
+    assert set(claims) == {"HZ-1-m", "HZ-2-m"}
+    for cid, rule in (("HZ-1-m", hz1_rule(2, 24)), ("HZ-2-m", hz2_rule("tree_n4_m256",
+                      "rsmhp_nt256", 2, 24))):  # fmt: skip
+        k = claims[cid].key
+        assert claims[cid].verdict == rule.verdict({f"{KEY}_low": k.ci_low / 100,
+                                                   f"{KEY}_high": k.ci_high / 100})  # fmt: skip
+        assert claims[cid].part == "beyond"
+    assert claims["HZ-1-m"].verdict == "supported"  # NBO's error grows 1% -> 3.6%
+    assert claims["HZ-2-m"].verdict == "not supported"  # here Monte Carlo's grows, the tree's not
+
+
+@pytest.mark.parametrize(
+    ("edit", "expected"),
+    [
+        (lambda hz: hz.update(models=["nowhere"]), "horizon.uav.models: ['nowhere'] not model"),
+        (lambda hz: hz.update(steps=[0, 60]), "horizon.uav.steps: [60] not before"),
+        (lambda hz: hz["methods"].update(nbo=False), "horizon.uav.methods.nbo: false"),
+        (
+            lambda hz: hz["claims"].update(tree="rsmhp_nt64"),
+            "horizon.uav.claims.tree: 'rsmhp_nt64' is not a PrunedTree member",
+        ),
+    ],
+)
+def test_bad_horizon_config_is_refused_naming_the_field(edit, expected):
+    from rsmhp.config import ConfigError, check_config
+
+    cfg = copy.deepcopy(CONFIG)
+    edit(cfg["horizon"]["uav"])
+    with pytest.raises(ConfigError, match=re.escape(expected)):
+        check_config(cfg)
