@@ -18,6 +18,8 @@ Core (model-independent)
                     the argument, the value and what is allowed)
 Models
   lqg               the scalar "oven" LQG case study and all its closed forms
+  lqg_horizon       the oven LQG at long horizons: limits in H, the horizon at which the
+                    optimal first control stops depending on H (closed forms)
   uav               UAV target tracking: kinematics, target, sensor, tracker (filterpy, the
                     reference), stepper (compiled closed-loop step: aircraft, target,
                     tracker), kernel (numpy oracle), fused (compiled weighted cost + exact
@@ -27,17 +29,19 @@ Models
                     dpw (compiled tree search with double progressive widening),
                     simulation, recording
 Stages of the pipeline (one module per model and stage)
-  experiments       lqg, estimators, uav, decisions_lqg, decisions_uav, frontier: config ->
-                    tidy tables
-  analysis          lqg, estimators, uav, decisions_lqg, decisions_uav, frontier: tables ->
-                    statistics
-  figures           lqg, estimators, uav, decisions, frontier: seaborn figures (PNG + PDF)
+  experiments       lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon:
+                    config -> tidy tables
+  analysis          lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon:
+                    tables -> statistics
+  figures           lqg, estimators, uav, decisions, frontier, horizon: seaborn figures (PNG
+                    + PDF)
   recording         rerun recordings of sampled trajectory trees
   claims            per study: the claims (key number + verdict rule) from the statistics;
                     claims.paper: the paper's statements, each with its evidence and verdict
   narrative         per study: the report section's prose, tables and appendix (Markdown)
   ledger            the claims data model: KeyNumber, Claim, Section
-  verdicts          verdict rules as objects (Rule, Case, at_most, ci_side): text + evaluation
+  verdicts          verdict rules as objects (Rule, Case, at_most, ci_side, non_inferior):
+                    text + evaluation
   markdown          number formatting and Markdown tables
   provenance        commit, config hash, package versions, BLAS and CPU of a run
   report            renders the main text, appendix, claims and glance table from the sections
