@@ -80,3 +80,17 @@ def test_bad_input_is_refused():
         lh.first_control_gain(0, a=0.5, r=1.0)
     with pytest.raises(ValueError, match="eps"):
         lh.vanishing_horizon(a=0.5, r=1.0, eps=0.0)
+
+
+def test_horizon_table_and_its_text_read_the_closed_forms():
+    from rsmhp.analysis.horizon import lqg_horizon_table
+    from rsmhp.narrative.horizon import _lqg_text
+
+    q = lqg_horizon_table([0.3, 0.5], [6, 24], r=10.0, sigma=1.0, eps=0.01)
+    row = q.set_index("a").loc[0.5]
+    assert row["nbo_limit"] == pytest.approx(10.0 / (1 - 0.25))
+    assert row["nbo_share_H6"] == pytest.approx(100 * (1 - 0.5**12))
+    assert row["vanishing_H"] == lh.vanishing_horizon(a=0.5, r=10.0)
+    assert row["stationary_H"] == lh.stationary_horizon(a=0.5, r=10.0)
+    text = _lqg_text(q, 0.5, 0.01)
+    assert f"at H = {int(row['vanishing_H'])} (from H = " in text and "13.33" in text

@@ -66,6 +66,8 @@ rule horizon_uav_summary:
         runtime=10,
     params:
         cfg=canonical(HZ),
+        lqg=canonical(config["horizon"]["lqg"]),
+        lqg_model=pick(config["lqg"]["model"], "a", "r", "sigma"),
         seed=config["seed"],
         code=code_digest("workflow/scripts/horizon_uav_summary.py"),
     script:

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.analysis.horizon import summarize_approx, summarize_horizon_regret
+from rsmhp.analysis.horizon import lqg_horizon_table, summarize_approx, summarize_horizon_regret
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.horizon import horizon_contracts
 from rsmhp.io import write_csv, write_text
@@ -25,8 +25,14 @@ with rule_logging(snakemake) as log:
     regret = pd.concat(regret, ignore_index=True)
     a_sum = summarize_approx(approx, p.seed, int(p.cfg["bootstrap"]))
     r_sum = summarize_horizon_regret(regret)
-    tables = horizon_tables(a_sum, r_sum)
-    section = horizon_section(approx, a_sum, r_sum, tables, p.cfg, p.seed)
+    lq, model = p.lqg, p.lqg_model
+    lqg_table = lqg_horizon_table(
+        lq["a_values"], lq["H"], r=model["r"], sigma=model["sigma"], eps=lq["eps"]
+    )
+    tables = horizon_tables(a_sum, r_sum, lqg_table)
+    section = horizon_section(
+        approx, a_sum, r_sum, tables, p.cfg, p.seed, lqg_table, lq, model["a"]
+    )
     write_csv(a_sum, snakemake.output.approx)
     write_csv(r_sum, snakemake.output.regret)
     for path in snakemake.output.tables:

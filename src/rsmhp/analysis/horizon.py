@@ -31,12 +31,14 @@ import numpy as np
 import pandas as pd
 from scipy import stats as sps
 
+from rsmhp import lqg, lqg_horizon
 from rsmhp.seeding import job_rng
 
 __all__ = [
     "APPROX_SUMMARY_COLUMNS",
     "REGRET_SUMMARY_COLUMNS",
     "Growth",
+    "lqg_horizon_table",
     "rmse_growth",
     "state_errors",
     "summarize_approx",
@@ -229,3 +231,25 @@ def summarize_horizon_regret(regret: pd.DataFrame) -> pd.DataFrame:
         plan_ms=("plan_ms", "median"),
     ).reset_index()  # fmt: skip
     return out[REGRET_SUMMARY_COLUMNS]
+
+
+def lqg_horizon_table(a_values, H_values, *, r: float, sigma: float, eps: float) -> pd.DataFrame:
+    """Closed forms of the oven LQG at long horizons (:mod:`rsmhp.lqg_horizon`), one row per
+    a: NBO's error limit :math:`r\\sigma^2/(1-(1-a)^2)` (``nbo_limit``) and its share
+    reached at each H of ``H_values`` (``nbo_share_H<H>``, %); the first H at which the
+    paper's optimal first control is at most ``eps`` of its one-step value
+    (``vanishing_H``); the stage-cost variant's stationary gain (``k_inf``) and the first H
+    at which the H-step gain is within ``eps`` of it (``stationary_H``)."""
+    rows = []
+    for a in a_values:
+        lim = lqg_horizon.nbo_error_limit(a=a, r=r, sigma=sigma)
+        row = {"a": float(a), "nbo_limit": lim}
+        for H in H_values:
+            row[f"nbo_share_H{int(H)}"] = 100 * lqg.nbo_error(int(H), a=a, r=r, sigma=sigma) / lim
+        row.update(
+            vanishing_H=lqg_horizon.vanishing_horizon(a=a, r=r, eps=eps),
+            k_inf=lqg_horizon.stationary_gain(a=a, r=r),
+            stationary_H=lqg_horizon.stationary_horizon(a=a, r=r, eps=eps),
+        )
+        rows.append(row)
+    return pd.DataFrame(rows)

@@ -19,7 +19,7 @@ from rsmhp.palette import method_label
 
 __all__ = ["FIGURES", "TABLES", "horizon_section", "horizon_tables"]
 
-TABLES = ("hz_uav_approx", "hz_uav_regret")
+TABLES = ("hz_uav_approx", "hz_uav_regret", "hz_lqg")
 
 
 def _ci(lo: pd.Series, hi: pd.Series) -> list[str]:
@@ -29,10 +29,13 @@ def _ci(lo: pd.Series, hi: pd.Series) -> list[str]:
     ]
 
 
-def horizon_tables(approx_summary: pd.DataFrame, regret_summary: pd.DataFrame) -> dict[str, str]:
+def horizon_tables(
+    approx_summary: pd.DataFrame, regret_summary: pd.DataFrame, lqg_table: pd.DataFrame
+) -> dict[str, str]:
     """Markdown tables ``hz_uav_approx`` (per model, H and method: relative bias and RMSE of
-    the cost estimate in percent with CIs, the reference's relative SE, rank correlation) and
-    ``hz_uav_regret`` (relative regret, its part due to the approximation, planning ms)."""
+    the cost estimate in percent with CIs, the reference's relative SE, rank correlation),
+    ``hz_uav_regret`` (relative regret, its part due to the approximation, planning ms) and
+    ``hz_lqg`` (:func:`rsmhp.analysis.horizon.lqg_horizon_table`)."""
     a = approx_summary
     t1 = pd.DataFrame(
         {
@@ -61,10 +64,50 @@ def horizon_tables(approx_summary: pd.DataFrame, regret_summary: pd.DataFrame) -
             "ms/step": r["plan_ms"],
         }
     )
+    q = lqg_table
+    t3 = pd.DataFrame(
+        {
+            "a": q["a"],
+            "NBO error limit": q["nbo_limit"],
+            **{
+                f"reached at H = {c.removeprefix('nbo_share_H')} %": q[c]
+                for c in q.columns
+                if c.startswith("nbo_share_H")
+            },
+            "first control vanishes at H": q["vanishing_H"].astype(int),
+            "stage-cost K∞": q["k_inf"],
+            "K_H within eps of K∞ at H": q["stationary_H"].astype(int),
+        }
+    )
     return {
         "hz_uav_approx": markdown_table(t1, digits=3, missing="undefined", signed=("bias %",)),
         "hz_uav_regret": markdown_table(t2, digits=3),
+        "hz_lqg": markdown_table(t3, digits=4),
     }
+
+
+def _lqg_text(q: pd.DataFrame, a_model: float, eps: float) -> str:
+    """The oven LQG at long horizons for the model's a (closed forms, table hz_lqg)."""
+    row = q.iloc[int(np.argmin(np.abs(q["a"].to_numpy(float) - a_model)))]
+    shares = [c for c in q.columns if c.startswith("nbo_share_H")]
+    reach = ", ".join(
+        f"{fmt(float(row[c]), 4)}% at H = {c.removeprefix('nbo_share_H')}" for c in shares
+    )
+    return (
+        f"Oven LQG (closed forms, a = {fmt(float(row['a']), 2)}): NBO's error r v_H reaches "
+        f"{reach} of its limit r σ²/(1 − (1 − a)²) = {fmt(float(row['nbo_limit']), 4)}. The "
+        "paper calls a horizon long when the optimal policy is nearly stationary; in its "
+        "terminal-cost problem the optimal first control shrinks like (1 − a)^(H−1) (the "
+        "controls gather at the end of the horizon), so its stationary limit is zero: it "
+        f"falls below {fmt(100 * eps, 2)}% of its one-step value at H = "
+        f"{int(row['vanishing_H'])} (from H = {int(q['vanishing_H'].min())} to "
+        f"{int(q['vanishing_H'].max())} over a ∈ [{fmt(float(q['a'].min()), 2)}, "
+        f"{fmt(float(q['a'].max()), 2)}]). With a stage cost r(x_k − T)² at every step "
+        "(beyond the paper) the first-step gain is within "
+        f"{fmt(100 * eps, 2)}% of the stationary Riccati gain from H = "
+        f"{int(row['stationary_H'])} ({int(q['stationary_H'].min())} to "
+        f"{int(q['stationary_H'].max())} over a)."
+    )
 
 
 def _setting(cfg: Mapping[str, Any], hs: Sequence[int]) -> str:
@@ -131,12 +174,24 @@ def horizon_section(
     tables: Mapping[str, str],
     cfg: Mapping[str, Any],
     seed: int,
+    lqg_table: pd.DataFrame,
+    lqg_cfg: Mapping[str, Any],
+    a_model: float,
 ) -> Section:
-    """The horizon study's report section (order 33); ``cfg`` is ``horizon.uav``."""
+    """The horizon study's report section (order 33); ``cfg`` is ``horizon.uav``,
+    ``lqg_cfg`` ``horizon.lqg``, ``a_model`` the oven model's a (``lqg.model.a``)."""
     claims = horizon_claims(approx, approx_summary, cfg, seed)
     hs = sorted(int(h) for h in cfg["H"])
     body = "\n".join(
-        [_setting(cfg, hs), "", _findings(claims, approx_summary, regret_summary), "", *_FIGURE]
+        [
+            _setting(cfg, hs),
+            "",
+            _findings(claims, approx_summary, regret_summary),
+            "",
+            _lqg_text(lqg_table, a_model, float(lqg_cfg["eps"])),
+            "",
+            *_FIGURE,
+        ]
     )
     appendix = "\n".join(
         [
@@ -154,6 +209,16 @@ def horizon_section(
             "the part due to the cost approximation):",
             "",
             tables["hz_uav_regret"],
+            "",
+            "Oven LQG at long horizons, closed forms (`rsmhp.lqg_horizon`; r, σ of the oven "
+            "model): NBO's error limit r σ²/(1 − (1 − a)²) and the share of it reached at H; "
+            "the first H at which the paper's optimal first control L_H (T − (1 − a)^H x_0), "
+            f"L_H = r a (1 − a)^(H−1) / (1 + r a² Σ_(n<H) (1 − a)^(2n)), is at most eps = "
+            f"{fmt(float(lqg_cfg['eps']), 2)} of L_1; the stationary gain K∞ of the stage-cost "
+            "variant (algebraic Riccati equation) and the first H whose first-step gain K_H "
+            "is within eps of it:",
+            "",
+            tables["hz_lqg"],
         ]
     )
     return Section(
