@@ -208,6 +208,10 @@ def test_claims_follow_their_rules():
             lambda hz: hz["claims"].update(tree="rsmhp_nt64"),
             "horizon.uav.claims.tree: 'rsmhp_nt64' is not a PrunedTree member",
         ),
+        (
+            lambda hz: hz["claims"].update(closed_model="paper2"),
+            "horizon.uav.claims.closed_model: 'paper2' is not a model of horizon.uav.models",
+        ),
     ],
 )
 def test_bad_horizon_config_is_refused_naming_the_field(edit, expected):
@@ -217,3 +221,57 @@ def test_bad_horizon_config_is_refused_naming_the_field(edit, expected):
     edit(cfg["horizon"]["uav"])
     with pytest.raises(ConfigError, match=re.escape(expected)):
         check_config(cfg)
+
+
+def test_closed_loop_rows_are_the_simulations_and_pair_across_horizons():
+    """Oracle: each row is simulate_run's summary for the same model, H, seed and run; the
+    scenario (initial target and UAV) is the same at every H, so runs pair across H."""
+    from rsmhp.experiments.horizon import closed_contract, horizon_setup, run_horizon_closed
+    from rsmhp.uav import methods
+    from rsmhp.uav.simulation import draw_scenario, simulate_run
+
+    cfg = {**HZ, "closed_runs": 2, "methods": {"nbo": True, "rsmhp_nt": [16]}}
+    rows = {H: run_horizon_closed(_uav(), MODELS, cfg, "paper", H, 9) for H in (2, 4)}
+    for H, df in rows.items():
+        check_table(df, "closed", closed_contract(cfg, "paper", H))
+        setup = horizon_setup(_uav(), MODELS[0], H)
+        want, _ = simulate_run(setup, methods.from_name("rsmhp_nt16"), 9, 1)
+        got = df[(df["method"] == "rsmhp_nt16") & (df["run"] == 1)].iloc[0]
+        assert got["mean_error"] == want["mean_error"] and got["plan_ms"] > 0
+    a, b = (horizon_setup(_uav(), MODELS[0], H) for H in (2, 4))
+    np.testing.assert_array_equal(draw_scenario(a, 9, 1).target, draw_scenario(b, 9, 1).target)
+
+
+def test_advantage_growth_and_hz3_against_their_rule():
+    from rsmhp.analysis.horizon import advantage_growth, summarize_closed
+    from rsmhp.claims.horizon import _hz3, hz3_rule
+
+    rng = np.random.default_rng(8)
+    n = 40
+    base = rng.normal(100.0, 30.0, n)  # shared by every method and H: cancels in the pairing
+    rows = []
+    for H, adv in ((2, -5.0), (24, -20.0)):
+        for method, shift in (("nbo", 0.0), ("rsmhp_nt256", adv)):
+            e = base + shift + rng.normal(0.0, 2.0, n)
+            rows += [{"model": "m", "H": H, "method": method, "family": method[:5], "run": r,
+                      "mean_error": e[r], "final_error": 0.0, "plan_ms": 1.0}
+                     for r in range(n)]  # fmt: skip
+    closed = pd.DataFrame(rows)
+    w = closed.pivot_table(index="run", columns=["H", "method"], values="mean_error")
+    D = (w[(24, "rsmhp_nt256")] - w[(24, "nbo")]) - (w[(2, "rsmhp_nt256")] - w[(2, "nbo")])
+    a = advantage_growth(closed, "m", "rsmhp_nt256", 2, 24, seed=1, n_boot=2000)
+    assert a.mean == pytest.approx(D.mean()) and a.n == n and a.high < 0
+    assert a.d_lo == pytest.approx(-5.0, abs=1.5) and a.d_hi == pytest.approx(-20.0, abs=1.5)
+    c = _hz3(closed, "m", "rsmhp_nt256", 2, 24, seed=1, n_boot=2000)
+    assert (
+        c.verdict
+        == hz3_rule("rsmhp_nt256", 2, 24).verdict({"D_low": c.key.ci_low, "D_high": c.key.ci_high})
+        == "supported"
+    )
+    s = summarize_closed(closed, seed=1, n_boot=500).set_index(["H", "method"])
+    assert s.loc[(24, "rsmhp_nt256"), "error_diff"] == pytest.approx(
+        (w[(24, "rsmhp_nt256")] - w[(24, "nbo")]).mean()
+    )
+    assert s.loc[(2, "nbo"), "error_diff"] == 0
+    with pytest.raises(ValueError, match="no closed-loop runs of 'rsmhp_nt64' at H = 2"):
+        advantage_growth(closed, "m", "rsmhp_nt64", 2, 24, seed=1, n_boot=100)

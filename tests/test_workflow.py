@@ -372,12 +372,12 @@ def test_horizon_outputs(run_j2, tiny):
     report = (run_j2 / "results/paper/replication.md").read_text()
     assert report.index("## Planners at equal compute") < report.index("## Long horizons")
     for model in cfg["models"]:
-        for cid in (f"HZ-1-{model}", f"HZ-2-{model}"):
+        for cid in (f"HZ-1-{model}", f"HZ-2-{model}", f"HZ-3-{model}"):
             assert f"| {cid} |" in report
-    for name in ("hz_uav_error", "hz_uav_time"):
+    for name in ("hz_uav_error", "hz_uav_time", "hz_uav_closed"):
         assert (run_j2 / f"results/paper/figures/{name}.png").read_bytes()[:4] == b"\x89PNG"
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
-    for table in ("hz_uav_approx", "hz_uav_regret", "hz_lqg"):
+    for table in ("hz_uav_approx", "hz_uav_regret", "hz_uav_closed", "hz_lqg"):
         assert (run_j2 / f"results/tables/{table}.md").read_text().strip() in appendix
 
 
@@ -503,7 +503,7 @@ def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, 
     captions = sorted((ROOT / "workflow/report").glob("*.rst"))
     figures = [p.stem for p in (run_j2 / "results/figures").glob("*.png")]
     tables = [p.stem for p in (run_j2 / "results/tables").glob("*.md")]
-    assert len(figures) == 20 and len(tables) == 21
+    assert len(figures) == 21 and len(tables) == 22
     assert {c.stem for c in captions} == set(figures) | {f"table_{t}" for t in tables}
     for name in figures:
         assert f"{name}.png" in html, name

@@ -388,6 +388,12 @@ def _horizon_problems(config: Mapping[str, Any], names: list, n_steps: int) -> l
         )
     run = _member_names(methods)
     claims = hz.get("claims", {}) or {}
+    closed = claims.get("closed_model") or ""
+    if closed and closed not in models:
+        problems.append(
+            f"{path}.claims.closed_model: {closed!r} is not a model of {path}.models "
+            f"(allowed: {', '.join(models) or 'none configured'}, or '')"
+        )
     for key, family in (("tree", PrunedTree), ("monte_carlo", MonteCarlo)):
         name = claims.get(key) or ""
         ok = [n for n, m in run.items() if isinstance(m, family)]

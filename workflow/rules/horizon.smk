@@ -44,14 +44,41 @@ rule horizon_uav:
         "../scripts/horizon_uav.py"
 
 
+rule horizon_uav_closed:
+    """UAV horizon study, one model variant and horizon: paired closed-loop runs of every method."""
+    output:
+        "results/horizon/uav/{hmodel}_H{H}_closed.csv",
+    log:
+        "results/logs/horizon_uav_closed/{hmodel}_H{H}.log",
+    benchmark:
+        "results/benchmarks/horizon_uav_closed/{hmodel}_H{H}.tsv"
+    priority: PRIORITY["horizon_uav"]
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=60,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(config["decisions"]["uav"]["models"]),
+        cfg=pick(HZ, "closed_runs", "methods"),
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/horizon_uav_closed.py"),
+    script:
+        "../scripts/horizon_uav_closed.py"
+
+
 rule horizon_uav_summary:
     """UAV horizon study: statistics by horizon, tables, claims HZ-1/HZ-2, report section."""
     input:
         approx=expand("results/horizon/uav/{job}_approx.csv", job=HZ_JOBS),
         regret=expand("results/horizon/uav/{job}_regret.csv", job=HZ_JOBS),
+        closed=expand("results/horizon/uav/{job}_closed.csv", job=HZ_JOBS),
     output:
         approx="results/horizon/uav_approx_summary.csv",
         regret="results/horizon/uav_regret_summary.csv",
+        closed="results/horizon/uav_closed_summary.csv",
         tables=table_outputs(HORIZON_TABLES, "Long horizons"),
         section="results/report/horizon_uav.json",
     log:
@@ -79,6 +106,7 @@ rule horizon_figures:
     input:
         approx="results/horizon/uav_approx_summary.csv",
         regret="results/horizon/uav_regret_summary.csv",
+        closed="results/horizon/uav_closed_summary.csv",
     output:
         figure_outputs(HORIZON_FIGURES, "Long horizons"),
     log:

@@ -2,9 +2,17 @@
 
 from pathlib import Path
 
-from rsmhp.analysis.horizon import APPROX_SUMMARY_COLUMNS, REGRET_SUMMARY_COLUMNS
+from rsmhp.analysis.horizon import (
+    APPROX_SUMMARY_COLUMNS,
+    CLOSED_SUMMARY_COLUMNS,
+    REGRET_SUMMARY_COLUMNS,
+)
 from rsmhp.figures import save_figure
-from rsmhp.figures.horizon import horizon_error_figure, horizon_time_figure
+from rsmhp.figures.horizon import (
+    horizon_closed_figure,
+    horizon_error_figure,
+    horizon_time_figure,
+)
 from rsmhp.io import read_table
 from rsmhp.pipeline import rule_logging
 
@@ -14,3 +22,5 @@ with rule_logging(snakemake):
     regret = read_table(snakemake.input.regret, REGRET_SUMMARY_COLUMNS)
     save_figure(horizon_error_figure(approx), outdir / "hz_uav_error")
     save_figure(horizon_time_figure(regret), outdir / "hz_uav_time")
+    closed = read_table(snakemake.input.closed, CLOSED_SUMMARY_COLUMNS)
+    save_figure(horizon_closed_figure(closed), outdir / "hz_uav_closed")

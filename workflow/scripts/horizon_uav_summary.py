@@ -4,9 +4,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.analysis.horizon import lqg_horizon_table, summarize_approx, summarize_horizon_regret
+from rsmhp.analysis.horizon import (
+    lqg_horizon_table,
+    summarize_approx,
+    summarize_closed,
+    summarize_horizon_regret,
+)
 from rsmhp.contracts import read_checked
-from rsmhp.experiments.horizon import horizon_contracts
+from rsmhp.experiments.horizon import closed_contract, horizon_contracts
 from rsmhp.io import write_csv, write_text
 from rsmhp.narrative.horizon import horizon_section, horizon_tables
 from rsmhp.pipeline import rule_logging
@@ -14,27 +19,31 @@ from rsmhp.pipeline import rule_logging
 with rule_logging(snakemake) as log:
     p = snakemake.params
     jobs = [(m, int(h)) for m in p.cfg["models"] for h in p.cfg["H"]]
-    approx, regret = [], []
-    for (model, H), a_path, r_path in zip(
-        jobs, snakemake.input.approx, snakemake.input.regret, strict=True
+    approx, regret, closed = [], [], []
+    for (model, H), a_path, r_path, c_path in zip(
+        jobs, snakemake.input.approx, snakemake.input.regret, snakemake.input.closed, strict=True
     ):
         c_approx, c_regret = horizon_contracts(p.cfg, model, H)
         approx.append(read_checked(a_path, c_approx))
         regret.append(read_checked(r_path, c_regret))
+        closed.append(read_checked(c_path, closed_contract(p.cfg, model, H)))
     approx = pd.concat(approx, ignore_index=True)
     regret = pd.concat(regret, ignore_index=True)
+    closed = pd.concat(closed, ignore_index=True)
+    c_sum = summarize_closed(closed, p.seed, int(p.cfg["bootstrap"]))
     a_sum = summarize_approx(approx, p.seed, int(p.cfg["bootstrap"]))
     r_sum = summarize_horizon_regret(regret)
     lq, model = p.lqg, p.lqg_model
     lqg_table = lqg_horizon_table(
         lq["a_values"], lq["H"], r=model["r"], sigma=model["sigma"], eps=lq["eps"]
     )
-    tables = horizon_tables(a_sum, r_sum, lqg_table)
+    tables = horizon_tables(a_sum, r_sum, lqg_table, c_sum)
     section = horizon_section(
-        approx, a_sum, r_sum, tables, p.cfg, p.seed, lqg_table, lq, model["a"]
+        approx, a_sum, r_sum, tables, p.cfg, p.seed, lqg_table, lq, model["a"], closed
     )
     write_csv(a_sum, snakemake.output.approx)
     write_csv(r_sum, snakemake.output.regret)
+    write_csv(c_sum, snakemake.output.closed)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
     section.save(snakemake.output.section)

@@ -36,12 +36,16 @@ from rsmhp.seeding import job_rng
 
 __all__ = [
     "APPROX_SUMMARY_COLUMNS",
+    "CLOSED_SUMMARY_COLUMNS",
     "REGRET_SUMMARY_COLUMNS",
+    "Advantage",
     "Growth",
+    "advantage_growth",
     "lqg_horizon_table",
     "rmse_growth",
     "state_errors",
     "summarize_approx",
+    "summarize_closed",
     "summarize_horizon_regret",
 ]
 
@@ -253,3 +257,103 @@ def lqg_horizon_table(a_values, H_values, *, r: float, sigma: float, eps: float)
         )
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+CLOSED_SUMMARY_COLUMNS = [
+    "model",
+    "H",
+    "method",
+    "family",
+    "runs",
+    "mean_error",
+    "error_diff",
+    "error_diff_low",
+    "error_diff_high",
+    "plan_ms",
+]
+
+
+def _paired(model: str, closed: pd.DataFrame) -> pd.DataFrame:
+    """mean_error per run (rows) and (H, method) (columns) of ``model``."""
+    g = closed[closed["model"] == model]
+    return g.pivot_table(index="run", columns=["H", "method"], values="mean_error")
+
+
+def summarize_closed(closed: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFrame:
+    """Per (model, H, method): runs, mean location error (m), the paired difference method −
+    NBO over runs with its 95% percentile-bootstrap CI (stream keyed on model, H, method),
+    and the median planning ms per step."""
+    base = _baseline_name()
+    rows = []
+    for (model, H, method, family), g in closed.groupby(
+        ["model", "H", "method", "family"], sort=False
+    ):
+        w = _paired(model, closed)
+        d = (w[(H, method)] - w[(H, base)]).dropna().to_numpy(float)
+        key = {"model": model, "H": int(H), "method": method}
+        if d.size >= 2 and method != base:
+            rng = job_rng(seed, "horizon_closed", **key)
+            idx = rng.integers(0, d.size, size=(n_boot, d.size))
+            lo, hi = (float(v) for v in np.quantile(d[idx].mean(axis=1), [0.025, 0.975]))
+        else:
+            lo = hi = float(d.mean()) if d.size else float("nan")
+        rows.append(
+            {
+                **key,
+                "family": family,
+                "runs": len(g),
+                "mean_error": float(g["mean_error"].mean()),
+                "error_diff": float(d.mean()) if d.size else float("nan"),
+                "error_diff_low": lo,
+                "error_diff_high": hi,
+                "plan_ms": float(g["plan_ms"].median()),
+            }
+        )
+    return pd.DataFrame(rows, columns=CLOSED_SUMMARY_COLUMNS)
+
+
+class Advantage(NamedTuple):
+    """Change of the closed-loop advantage d(H) = error(method) − error(NBO) from ``h_lo``
+    to ``h_hi`` (m; negative: the advantage grows), paired over ``n`` runs, with its 95%
+    bootstrap CI, the two mean advantages ``d_lo``, ``d_hi`` and the SD of the paired change
+    over runs (a CI half-width w needs about (1.96 sd / w)² runs)."""
+
+    mean: float
+    low: float
+    high: float
+    n: int
+    d_lo: float
+    d_hi: float
+    sd: float
+
+
+def advantage_growth(
+    closed: pd.DataFrame, model: str, method: str, h_lo: int, h_hi: int, seed: int, n_boot: int
+) -> Advantage:
+    r""":math:`D = \overline{d_r(H_{hi}) - d_r(H_{lo})}` with :math:`d_r(H)` = mean error of
+    ``method`` − NBO's in run r at horizon H (the same scenario at both H); 95% bootstrap CI
+    over runs. ValueError if a horizon or method is missing or fewer than 2 runs pair."""
+    base = _baseline_name()
+    w = _paired(model, closed)
+    for h in (h_lo, h_hi):
+        for m in (method, base):
+            if (h, m) not in w.columns:
+                raise ValueError(f"no closed-loop runs of {m!r} at H = {h} on {model!r}")
+    d_lo = w[(h_lo, method)] - w[(h_lo, base)]
+    d_hi = w[(h_hi, method)] - w[(h_hi, base)]
+    D = (d_hi - d_lo).dropna().to_numpy(float)
+    if D.size < 2:
+        raise ValueError(f"{method!r} on {model!r}: {D.size} paired run(s)")
+    rng = job_rng(seed, "horizon_advantage", model=model, method=method, h_lo=h_lo, h_hi=h_hi)
+    idx = rng.integers(0, D.size, size=(n_boot, D.size))
+    lo, hi = np.quantile(D[idx].mean(axis=1), [0.025, 0.975])
+    return Advantage(
+        float(D.mean()), float(lo), float(hi), int(D.size), float(d_lo.mean()),
+        float(d_hi.mean()), float(D.std(ddof=1)),
+    )  # fmt: skip
+
+
+def _baseline_name() -> str:
+    from rsmhp.uav import methods
+
+    return methods.baseline()().name

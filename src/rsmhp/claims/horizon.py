@@ -8,6 +8,10 @@ horizons of ``horizon.uav.H``.
   (:func:`rsmhp.analysis.horizon.rmse_growth`, the same belief states at both). NBO's cost
   approximation error grows with H: *supported* if the 95% bootstrap CI of g lies above 0,
   *not supported* below 0, *inconclusive* otherwise.
+* **HZ-3** (:func:`hz3_rule`, one model: ``horizon.uav.claims.closed_model``): D = (closed-loop
+  mean error of the Monte-Carlo member − NBO's at H_hi) − (the same at H_lo), paired over
+  runs (the same scenarios at both H; m). The advantage of sampling over NBO grows with H:
+  *supported* if the CI of D lies below 0, *not supported* above 0, *inconclusive* otherwise.
 * **HZ-2** (:func:`hz2_rule`): d = g(pruned tree) − g(Monte Carlo with as many trajectories),
   the members fixed in ``horizon.uav.claims``. The pruned tree's error grows with H more than
   Monte Carlo's: *supported* if the CI of d lies above 0, *not supported* below 0,
@@ -21,14 +25,14 @@ from typing import Any
 
 import pandas as pd
 
-from rsmhp.analysis.horizon import Growth, rmse_growth
+from rsmhp.analysis.horizon import Advantage, Growth, advantage_growth, rmse_growth
 from rsmhp.ledger import Claim, KeyNumber
 from rsmhp.markdown import fmt, fmt_ci
 from rsmhp.palette import method_label
 from rsmhp.uav import methods as registry
 from rsmhp.verdicts import Rule, ci_side
 
-__all__ = ["KEY", "horizon_claims", "hz1_rule", "hz2_rule"]
+__all__ = ["KEY", "horizon_claims", "hz1_rule", "hz2_rule", "hz3_rule"]
 
 KEY = "g"
 
@@ -59,6 +63,50 @@ def hz2_rule(tree: str, mc: str, h_lo: int, h_hi: int) -> Rule:
     )
 
 
+def hz3_rule(mc: str, h_lo: int, h_hi: int) -> Rule:
+    """HZ-3: the closed-loop advantage of ``mc`` over NBO is larger at H_hi than at H_lo."""
+    return ci_side(
+        "D",
+        0.0,
+        claimed="below",
+        basis=f"D = (mean error of {method_label(mc)} − NBO at H = {h_hi}) − (the same at "
+        f"H = {h_lo}), paired over runs (m)",
+    )
+
+
+def _hz3(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: int,
+         n_boot: int) -> Claim:  # fmt: skip
+    a: Advantage = advantage_growth(closed, model, mc, h_lo, h_hi, seed, n_boot)
+    rule = hz3_rule(mc, h_lo, h_hi)
+    half = (a.high - a.low) / 2
+    return Claim(
+        f"HZ-3-{model}",
+        f"On '{model}', the closed-loop advantage of {method_label(mc)} over NBO grows with "
+        f"the horizon (H = {h_lo} to {h_hi})",
+        "Beyond the paper (which plans at H = 6 only): Sec. II argues that NBO ignores the "
+        "uncertainty that accumulates over the horizon",
+        KeyNumber(
+            f"advantage change D, H = {h_lo} → {h_hi}",
+            a.mean,
+            a.low,
+            a.high,
+            unit="m",
+            reproducible="statistical",
+            digits=3,
+            null=0.0,
+        ),
+        rule.verdict({"D_low": a.low, "D_high": a.high}),
+        rule.text(),
+        measured=f"{a.n} paired runs; {method_label(mc)} − NBO mean error "
+        f"{fmt(a.d_lo, 3, True)} m at H = {h_lo}, {fmt(a.d_hi, 3, True)} m at H = {h_hi}; "
+        f"CI half-width {fmt(half, 2)} m from {a.n} runs (SD of the paired change "
+        f"{fmt(a.sd, 3)} m: a half-width of {fmt(half / 2, 2)} m would need about "
+        f"{4 * a.n} runs)",
+        part="beyond",
+        setup=f"UAV '{model}', closed loop, H = {h_lo} and {h_hi}",
+    )
+
+
 def _key(name: str, g: Growth) -> KeyNumber:
     return KeyNumber(
         name,
@@ -77,11 +125,16 @@ def _pct(g: Growth) -> Growth:
 
 
 def horizon_claims(
-    approx: pd.DataFrame, summary: pd.DataFrame, cfg: Mapping[str, Any], seed: int
+    approx: pd.DataFrame,
+    summary: pd.DataFrame,
+    cfg: Mapping[str, Any],
+    seed: int,
+    closed: pd.DataFrame | None = None,
 ) -> list[Claim]:
-    """HZ-1 and HZ-2 per model of ``summary`` (module doc). ``approx``: the cost-approximation
-    rows of every (model, H); ``summary``: :func:`rsmhp.analysis.horizon.summarize_approx`;
-    ``cfg``: ``horizon.uav``."""
+    """HZ-1 and HZ-2 per model of ``summary``, HZ-3 on the configured model (module doc).
+    ``approx``: the cost-approximation rows of every (model, H); ``summary``:
+    :func:`rsmhp.analysis.horizon.summarize_approx`; ``cfg``: ``horizon.uav``; ``closed``:
+    the closed-loop rows (:data:`rsmhp.experiments.horizon.CLOSED_COLUMNS`)."""
     if summary.empty:
         return []
     hs = sorted(int(h) for h in summary["H"].unique())
@@ -146,4 +199,9 @@ def horizon_claims(
                     setup=setup,
                 )
             )
+    closed_model = (cfg.get("claims", {}) or {}).get("closed_model") or ""
+    if closed is not None and closed_model and mc and not closed.empty:
+        sel = closed[closed["model"] == closed_model]
+        if {h_lo, h_hi} <= set(sel["H"]) and mc in set(sel["method"]):
+            out.append(_hz3(closed, closed_model, mc, h_lo, h_hi, seed, n_boot))
     return out

@@ -49,14 +49,17 @@ from rsmhp.seeding import job_rng
 from rsmhp.uav import fused, methods, target
 from rsmhp.uav.methods import Method
 from rsmhp.uav.planner import Belief, PlanningProblem
-from rsmhp.uav.simulation import UAVSetup
+from rsmhp.uav.simulation import UAVSetup, simulate_run
 
 __all__ = [
     "APPROX_COLUMNS",
+    "CLOSED_COLUMNS",
     "HORIZON_REGRET_COLUMNS",
+    "closed_contract",
     "horizon_contracts",
     "horizon_setup",
     "run_horizon",
+    "run_horizon_closed",
 ]
 
 log = logging.getLogger(__name__)
@@ -77,6 +80,9 @@ APPROX_COLUMNS = [
 
 #: the decision study's regret rows with the horizon and the measured planning time
 HORIZON_REGRET_COLUMNS = ["H", *REGRET_COLUMNS, "plan_ms"]
+
+#: one closed-loop run of one method with planning horizon H
+CLOSED_COLUMNS = ["model", "H", "method", "family", "run", "mean_error", "final_error", "plan_ms"]
 
 
 def horizon_setup(uav: Mapping[str, Any], model: Mapping[str, Any], H: int) -> UAVSetup:
@@ -249,3 +255,54 @@ def run_horizon(
         pd.DataFrame(approx, columns=APPROX_COLUMNS),
         pd.DataFrame(regret, columns=HORIZON_REGRET_COLUMNS),
     )
+
+
+def closed_contract(cfg: Mapping[str, Any], model: str, H: int) -> Contract:
+    """What the rule ``horizon_uav_closed`` writes for (``model``, ``H``): one row per
+    (method, run) for runs ``0..closed_runs-1``."""
+    keys = [(m, r) for m in _names(cfg) for r in range(int(cfg["closed_runs"]))]
+    return Contract(
+        rule="horizon_uav_closed",
+        columns=CLOSED_COLUMNS,
+        text=("model", "method", "family"),
+        integer=("H", "run"),
+        keys=("method", "run"),
+        expected=pd.DataFrame(keys, columns=["method", "run"]),
+        values={"model": model, "H": int(H)},
+    )
+
+
+def run_horizon_closed(
+    uav: Mapping[str, Any],
+    models: Sequence[Mapping[str, Any]],
+    cfg: Mapping[str, Any],
+    model: str,
+    H: int,
+    seed: int,
+) -> pd.DataFrame:
+    """Closed-loop runs ``0..closed_runs-1`` of every method of ``horizon.uav.methods`` on
+    ``model`` with planning horizon ``H`` (:func:`rsmhp.uav.simulation.simulate_run`: the
+    same scenarios and noise for every method and every H, so differences pair by run, also
+    across horizons). ``plan_ms``: planner milliseconds per step of the run (one thread)."""
+    var = variant(list(models), model)
+    setup = horizon_setup(uav, var, H)
+    planners = _names(cfg)
+    rows = []
+    with threadpool_limits(limits=1):
+        for name, m in planners.items():
+            for r in range(int(cfg["closed_runs"])):
+                summary, _ = simulate_run(setup, m, seed, r)
+                rows.append(
+                    {
+                        "model": model,
+                        "H": int(H),
+                        "method": name,
+                        "family": m.family,
+                        "run": r,
+                        "mean_error": summary["mean_error"],
+                        "final_error": summary["final_error"],
+                        "plan_ms": 1e3 * summary["plan_seconds"] / setup.steps,
+                    }
+                )
+            log.info("horizon %s H=%d closed loop: %s done", model, H, name)
+    return pd.DataFrame(rows, columns=CLOSED_COLUMNS)

@@ -6,7 +6,8 @@ reference's noise hides, corrected to 0, is drawn at :data:`RMSE_FLOOR_PCT`), bo
 relative bias (%). ``hz_uav_time``: top row the median planning milliseconds per step
 (log scale), bottom row the open-loop regret against the best of the methods' plans (% of the
 best cost: the part of the regret due to the cost approximation). x: the horizon H (log
-scale). One line per method in its palette colour.
+scale). ``hz_uav_closed``: the closed-loop mean location error minus NBO's on the same runs
+(m, 95% bootstrap CIs over runs). One line per method in its palette colour.
 """
 
 from __future__ import annotations
@@ -20,9 +21,9 @@ from rsmhp.figures import theme
 from rsmhp.palette import method_colour, method_label
 from rsmhp.uav import methods as _registry  # noqa: F401  (UAV method names get their colours)
 
-__all__ = ["FIGURES", "horizon_error_figure", "horizon_time_figure"]
+__all__ = ["FIGURES", "horizon_closed_figure", "horizon_error_figure", "horizon_time_figure"]
 
-FIGURES = ["hz_uav_error", "hz_uav_time"]
+FIGURES = ["hz_uav_error", "hz_uav_time", "hz_uav_closed"]
 
 #: relative RMSEs below this (%) are drawn at it (the log axis has no 0)
 RMSE_FLOOR_PCT = 1e-3
@@ -103,3 +104,9 @@ def horizon_time_figure(regret_summary: pd.DataFrame) -> plt.Figure:
         ("regret_methods_pct", "regret vs the methods' best plan (%)", False, None),
     ]
     return _grid(regret_summary, rows, "Planning time and decisions, by horizon")
+
+
+def horizon_closed_figure(closed_summary: pd.DataFrame) -> plt.Figure:
+    """``hz_uav_closed`` from :func:`rsmhp.analysis.horizon.summarize_closed`."""
+    rows = [("error_diff", "closed-loop mean error − NBO's (m)", False, None)]
+    return _grid(closed_summary, rows, "Closed loop against NBO, by horizon")

@@ -19,7 +19,7 @@ from rsmhp.palette import method_label
 
 __all__ = ["FIGURES", "TABLES", "horizon_section", "horizon_tables"]
 
-TABLES = ("hz_uav_approx", "hz_uav_regret", "hz_lqg")
+TABLES = ("hz_uav_approx", "hz_uav_regret", "hz_uav_closed", "hz_lqg")
 
 
 def _ci(lo: pd.Series, hi: pd.Series) -> list[str]:
@@ -30,7 +30,10 @@ def _ci(lo: pd.Series, hi: pd.Series) -> list[str]:
 
 
 def horizon_tables(
-    approx_summary: pd.DataFrame, regret_summary: pd.DataFrame, lqg_table: pd.DataFrame
+    approx_summary: pd.DataFrame,
+    regret_summary: pd.DataFrame,
+    lqg_table: pd.DataFrame,
+    closed_summary: pd.DataFrame,
 ) -> dict[str, str]:
     """Markdown tables ``hz_uav_approx`` (per model, H and method: relative bias and RMSE of
     the cost estimate in percent with CIs, the reference's relative SE, rank correlation),
@@ -79,9 +82,26 @@ def horizon_tables(
             "K_H within eps of K∞ at H": q["stationary_H"].astype(int),
         }
     )
+    c = closed_summary
+    t4 = pd.DataFrame(
+        {
+            "model": c["model"],
+            "H": c["H"].astype(int),
+            "method": c["method"].map(method_label),
+            "runs": c["runs"].astype(int),
+            "error (m)": c["mean_error"],
+            "− NBO (m)": c["error_diff"],
+            "95% CI (m)": [
+                fmt_ci(a, b, 3, True)
+                for a, b in zip(c["error_diff_low"], c["error_diff_high"], strict=True)
+            ],
+            "ms/step": c["plan_ms"],
+        }
+    )
     return {
         "hz_uav_approx": markdown_table(t1, digits=3, missing="undefined", signed=("bias %",)),
         "hz_uav_regret": markdown_table(t2, digits=3),
+        "hz_uav_closed": markdown_table(t4, digits=3, signed=("− NBO (m)",)),
         "hz_lqg": markdown_table(t3, digits=4),
     }
 
@@ -121,7 +141,8 @@ def _setting(cfg: Mapping[str, Any], hs: Sequence[int]) -> str:
         "reference's variance subtracted), 95% bootstrap CIs over states. **Decisions and "
         "time**: each method plans once per state, scored as in the decision study, and is "
         "timed on a second plan call (one thread). The tree search estimates no given plan's "
-        "cost: regret and time only."
+        f"cost: regret and time only. **Closed loop**: {int(cfg['closed_runs'])} paired runs "
+        "per method and H (the same scenarios at every H)."
     )
 
 
@@ -130,7 +151,7 @@ def _findings(claims: Sequence[Claim], a: pd.DataFrame, r: pd.DataFrame) -> str:
     for c in claims:
         k = c.key
         out.append(
-            f"{c.id} ({c.verdict}): {k.name} {fmt(k.value, k.digits, True)} pp "
+            f"{c.id} ({c.verdict}): {k.name} {fmt(k.value, k.digits, True)} {k.unit} "
             f"{fmt_ci(k.ci_low, k.ci_high, k.digits, True)}."
         )
     h_hi = max(int(h) for h in a["H"].unique())
@@ -154,6 +175,11 @@ def _findings(claims: Sequence[Claim], a: pd.DataFrame, r: pd.DataFrame) -> str:
 
 
 _FIGURE = [
+    "![Closed loop by horizon](figures/hz_uav_closed.png)",
+    "",
+    "*Closed-loop mean location error − NBO's on the same runs (m), by horizon; bars: 95% "
+    "bootstrap CIs over runs.*",
+    "",
     "![Cost approximation by horizon](figures/hz_uav_error.png)",
     "",
     "*Relative RMSE (log scale, noise-corrected; below the reference's noise drawn at "
@@ -177,10 +203,11 @@ def horizon_section(
     lqg_table: pd.DataFrame,
     lqg_cfg: Mapping[str, Any],
     a_model: float,
+    closed: pd.DataFrame | None = None,
 ) -> Section:
     """The horizon study's report section (order 33); ``cfg`` is ``horizon.uav``,
     ``lqg_cfg`` ``horizon.lqg``, ``a_model`` the oven model's a (``lqg.model.a``)."""
-    claims = horizon_claims(approx, approx_summary, cfg, seed)
+    claims = horizon_claims(approx, approx_summary, cfg, seed, closed)
     hs = sorted(int(h) for h in cfg["H"])
     body = "\n".join(
         [
@@ -209,6 +236,12 @@ def horizon_section(
             "the part due to the cost approximation):",
             "",
             tables["hz_uav_regret"],
+            "",
+            "Closed loop per model, horizon and method: mean location error over the paired "
+            "runs and its paired difference with NBO (95% bootstrap CI over runs), planning "
+            "ms per step (median over runs):",
+            "",
+            tables["hz_uav_closed"],
             "",
             "Oven LQG at long horizons, closed forms (`rsmhp.lqg_horizon`; r, σ of the oven "
             "model): NBO's error limit r σ²/(1 − (1 − a)²) and the share of it reached at H; "
