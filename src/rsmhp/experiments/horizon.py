@@ -20,7 +20,9 @@ horizon ``uav.planner.horizon``, so every H sees the same belief states) and com
   second, timed plan call with its own stream after it (milliseconds, one thread).
 
 Random streams are keyed on (model, run, step, H, method, replicate): a row never depends on
-the other methods, horizons or models, so jobs can run in any order.
+the other methods, horizons or models, so jobs can run in any order. The regret reuses the
+decision study's streams, keyed on (model, run, step) and the method: at every H the plans
+are scored on evaluation hypotheses from the same stream (common random numbers across H).
 """
 
 from __future__ import annotations
@@ -93,7 +95,7 @@ def horizon_setup(uav: Mapping[str, Any], model: Mapping[str, Any], H: int) -> U
 
 
 def _names(cfg: Mapping[str, Any]) -> dict[str, Method]:
-    return methods.from_config(cfg["methods"], "horizon.methods")
+    return methods.from_config(cfg["methods"], "horizon.uav.methods")
 
 
 def horizon_contracts(cfg: Mapping[str, Any], model: str, H: int) -> tuple[Contract, Contract]:
