@@ -182,20 +182,26 @@ def test_claims_follow_their_rules():
     lo = {m: rng.normal(0, 0.01, (25, 6)) for m in ("nbo", "tree_n4_m256", "rsmhp_nt256")}
     hi = {"nbo": rng.normal(0.02, 0.03, (25, 6)), "tree_n4_m256": rng.normal(0, 0.01, (25, 6)),
           "rsmhp_nt256": rng.normal(0, 0.04, (25, 6))}  # fmt: skip
-    df = pd.concat([_table(lo, H=2), _table(hi, H=24)], ignore_index=True)
+    # H = 4: the first horizon at which the tree (4^(H+1) > 256 leaves) is pruned
+    df = pd.concat([_table(lo, H=4), _table(hi, H=24)], ignore_index=True)
     df["family"] = df["method"].map({"nbo": "nbo", "tree_n4_m256": "tree", "rsmhp_nt256": "rsmhp"})
     summary = summarize_approx(df, seed=1, n_boot=300)
     cfg = {"bootstrap": 1000, "claims": {"tree": "tree_n4_m256", "monte_carlo": "rsmhp_nt256"}}
     claims = {c.id: c for c in horizon_claims(df, summary, cfg, seed=2)}
     assert set(claims) == {"HZ-1-m", "HZ-2-m"}
-    for cid, rule in (("HZ-1-m", hz1_rule(2, 24)), ("HZ-2-m", hz2_rule("tree_n4_m256",
-                      "rsmhp_nt256", 2, 24))):  # fmt: skip
+    for cid, rule in (("HZ-1-m", hz1_rule(4, 24)), ("HZ-2-m", hz2_rule("tree_n4_m256",
+                      "rsmhp_nt256", 4, 24))):  # fmt: skip
         k = claims[cid].key
         assert claims[cid].verdict == rule.verdict({f"{KEY}_low": k.ci_low / 100,
                                                    f"{KEY}_high": k.ci_high / 100})  # fmt: skip
         assert claims[cid].part == "beyond"
     assert claims["HZ-1-m"].verdict == "supported"  # NBO's error grows 1% -> 3.6%
     assert claims["HZ-2-m"].verdict == "not supported"  # here Monte Carlo's grows, the tree's not
+    # with H = 2 and 24 only, the tree (64 leaves at H = 2) is not pruned at H = 2: HZ-2 starts
+    # at the first pruned horizon, here only 24, so there is no HZ-2
+    df2 = df.assign(H=df["H"].replace({4: 2}))
+    ids = {c.id for c in horizon_claims(df2, summarize_approx(df2, 1, 200), cfg, seed=2)}
+    assert ids == {"HZ-1-m"}
 
 
 @pytest.mark.parametrize(

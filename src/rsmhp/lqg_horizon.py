@@ -13,8 +13,9 @@ With :math:`b = 1-a` and :math:`S_H = \sum_{n=0}^{H-1} b^{2n} = (1-b^{2H})/(1-b^
   stationary first control of this problem is *no control*, and the optimal sequence
   :math:`u_k \propto b^{H-1-k}` is never independent of k (it depends on the time to go).
   The paper's definition of a long horizon (an approximately stationary optimal policy) is met
-  only in this degenerate sense; :func:`vanishing_horizon` is the first H at which
-  :math:`L_H \le \epsilon L_1`.
+  only in this degenerate sense; :func:`vanishing_horizon` is the first H at which the
+  first control's gain :math:`L_H \le \epsilon L_1` (the control itself also scales with
+  :math:`T - b^H x_0`; for :math:`x_0 = 0` the two coincide).
 * **A stage-cost variant** (beyond the paper: :math:`\sum_{k<H} r(x_k - T)^2 + u_k^2 + r(x_H -
   T)^2`, the textbook regulator). Its Riccati recursion :math:`P_H = r`,
   :math:`P_k = r + b^2 P_{k+1} - (a b P_{k+1})^2 / (1 + a^2 P_{k+1})` gives the first-step

@@ -11,16 +11,17 @@ standard error :math:`s` of its reference,
   so :math:`E[e^2] = \mathrm{MSE} + \mathrm{Var}(\hat J_{ref})/J^2`: subtracting the
   reference's variance leaves the method's own error), both over plans and replicates;
 * ``rel_bias`` = mean of b over states, ``rel_rmse`` = :math:`\sqrt{\max(\overline q, 0)}`,
-  each with a 95% percentile-bootstrap CI over belief states (the resampled unit);
+  each with a 95% percentile-bootstrap CI that resamples *runs* (clusters: the belief states
+  of one run share its scenario, so they are not independent) and keeps all their states;
   ``ref_noise`` = :math:`\sqrt{\overline{s^2}}`, the reference's own relative SE; ``spearman``
   = mean over (state, replicate) of the rank correlation of estimate and reference over the
   plans (undefined where the estimate is constant over them, e.g. NBO's single hypothesis
   outside every plan's footprint: counted in ``spearman_undefined``).
 
 :func:`rmse_growth` is the paired change of ``rel_rmse`` between two horizons, resampling the
-same belief states at both. Regret and time per (model, H, method): mean relative regret
-(against the best plan found), its part due to the cost approximation (against the best of
-the methods' plans), and the median planning milliseconds.
+same runs (with their belief states) at both. Regret and time per (model, H, method): mean
+relative regret against the best plan found and against the best of the methods' plans, and
+the median planning milliseconds.
 """
 
 from __future__ import annotations
@@ -93,11 +94,16 @@ def state_errors(approx: pd.DataFrame) -> pd.DataFrame:
     ]
 
 
-def _rmse_ci(q: np.ndarray, rng: np.random.Generator, n_boot: int) -> tuple[float, float]:
-    idx = rng.integers(0, q.size, size=(n_boot, q.size))
-    boots = np.sqrt(np.maximum(q[idx].mean(axis=1), 0.0))
-    lo, hi = np.quantile(boots, [0.025, 0.975])
-    return float(lo), float(hi)
+def _cluster_means(
+    x: np.ndarray, runs: np.ndarray, rng: np.random.Generator, n_boot: int
+) -> np.ndarray:
+    """Bootstrap means of per-state values ``x`` resampling runs (clusters) with all their
+    states: ``n_boot`` values of sum(x over drawn runs) / (states of drawn runs)."""
+    ids, inv = np.unique(runs, return_inverse=True)
+    sums = np.bincount(inv, weights=x, minlength=ids.size)
+    counts = np.bincount(inv, minlength=ids.size).astype(float)
+    idx = rng.integers(0, ids.size, size=(n_boot, ids.size))
+    return sums[idx].sum(axis=1) / counts[idx].sum(axis=1)
 
 
 def _spearman(g: pd.DataFrame) -> float:
@@ -122,12 +128,17 @@ def summarize_approx(approx: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFra
     ):
         key = {"model": model, "H": int(H), "method": method}
         b, q = g["b"].to_numpy(float), g["q"].to_numpy(float)
+        runs = g["run"].to_numpy()
         r = rho[(rho["model"] == model) & (rho["H"] == H) & (rho["method"] == method)]["rho"]
-        if b.size >= 2:
-            b_boot = job_rng(seed, "horizon_bias", **key)
-            idx = b_boot.integers(0, b.size, size=(n_boot, b.size))
-            b_lo, b_hi = (float(v) for v in np.quantile(b[idx].mean(axis=1), [0.025, 0.975]))
-            q_lo, q_hi = _rmse_ci(q, job_rng(seed, "horizon_rmse", **key), n_boot)
+        if np.unique(runs).size >= 2:
+            bb = _cluster_means(b, runs, job_rng(seed, "horizon_bias", **key), n_boot)
+            b_lo, b_hi = (float(v) for v in np.quantile(bb, [0.025, 0.975]))
+            qb = np.sqrt(
+                np.maximum(
+                    _cluster_means(q, runs, job_rng(seed, "horizon_rmse", **key), n_boot), 0.0
+                )
+            )
+            q_lo, q_hi = (float(v) for v in np.quantile(qb, [0.025, 0.975]))
         else:
             b_lo = b_hi = q_lo = q_hi = float("nan")
         rows.append(
@@ -151,7 +162,8 @@ def summarize_approx(approx: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFra
 
 class Growth(NamedTuple):
     """Change of the relative RMSE between two horizons (``h_lo`` -> ``h_hi``), paired over
-    ``n`` belief states, with its 95% bootstrap CI; ``lo_value``/``hi_value`` the RMSEs."""
+    ``n`` belief states (bootstrap over their runs), with its 95% CI; ``lo_value`` and
+    ``hi_value`` the RMSEs."""
 
     mean: float
     low: float
@@ -190,7 +202,8 @@ def rmse_growth(
     minus: str | None = None,
 ) -> Growth:
     r""":math:`g = \mathrm{RMSE}_{rel}(H_{hi}) - \mathrm{RMSE}_{rel}(H_{lo})` of ``method``
-    on ``model``, resampling belief states jointly at both horizons (the same states); with
+    on ``model``, resampling runs (with all their belief states) jointly at both horizons (the
+    same states); with
     ``minus`` another method, :math:`g_{method} - g_{minus}` on jointly resampled states
     (``lo_value``/``hi_value`` are then ``method``'s RMSEs). ValueError if a horizon lacks a
     method or fewer than 2 states are shared."""
@@ -207,25 +220,40 @@ def rmse_growth(
         for i in range(len(parts))
     ]
 
-    def g(idx: np.ndarray | slice) -> np.ndarray:
-        out = _rmse(q[0][1][idx]) - _rmse(q[0][0][idx])
+    runs = wide.index.get_level_values("run").to_numpy()
+    ids, inv = np.unique(runs, return_inverse=True)
+    if ids.size < 2:
+        raise ValueError(f"{method!r} on {model!r}: {ids.size} run(s) (allowed: at least 2)")
+    counts = np.bincount(inv, minlength=ids.size).astype(float)
+    sums = [
+        (np.bincount(inv, weights=lo, minlength=ids.size),
+         np.bincount(inv, weights=hi, minlength=ids.size))
+        for lo, hi in q
+    ]  # fmt: skip
+
+    def g(idx: np.ndarray) -> np.ndarray:
+        n = counts[idx].sum(axis=-1)
+
+        def rm(sm: np.ndarray) -> np.ndarray:
+            return np.sqrt(np.maximum(sm[idx].sum(axis=-1) / n, 0.0))
+
+        out = rm(sums[0][1]) - rm(sums[0][0])
         if minus is not None:
-            out = out - (_rmse(q[1][1][idx]) - _rmse(q[1][0][idx]))
+            out = out - (rm(sums[1][1]) - rm(sums[1][0]))
         return out
 
     key = {"model": model, "method": method, "minus": minus or "", "h_lo": hs[0], "h_hi": hs[1]}
     rng = job_rng(seed, "horizon_growth", **key)
-    n = len(wide)
-    boots = g(rng.integers(0, n, size=(n_boot, n)))
+    boots = g(rng.integers(0, ids.size, size=(n_boot, ids.size)))
     c_lo, c_hi = np.quantile(boots, [0.025, 0.975])
     a, b = float(_rmse(q[0][0])), float(_rmse(q[0][1]))
-    return Growth(float(g(slice(None))), float(c_lo), float(c_hi), n, a, b, *hs)
+    return Growth(float(g(np.arange(ids.size))), float(c_lo), float(c_hi), len(wide), a, b, *hs)
 
 
 def summarize_horizon_regret(regret: pd.DataFrame) -> pd.DataFrame:
-    """One row per (model, H, method): mean relative regret (%), its part due to the cost
-    approximation (regret against the best of the methods' plans, % of the best cost) and
-    the median planning milliseconds per step."""
+    """One row per (model, H, method): mean relative regret against the best plan found (%),
+    mean regret against the best of the methods' plans (% of the best cost) and the median
+    planning milliseconds per step."""
     df = regret.assign(
         r=100 * regret["regret_rel"], rm=100 * regret["regret_methods"] / regret["best_cost"]
     )
@@ -280,29 +308,33 @@ def _paired(model: str, closed: pd.DataFrame) -> pd.DataFrame:
 
 
 def summarize_closed(closed: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFrame:
-    """Per (model, H, method): runs, mean location error (m), the paired difference method −
-    NBO over runs with its 95% percentile-bootstrap CI (stream keyed on model, H, method),
-    and the median planning ms per step."""
+    """Per (model, H, method), over the runs that pair with NBO's: their number, the mean
+    location error (m), the paired difference method − NBO with its 95% percentile-bootstrap
+    CI (stream keyed on model, H, method; NaN with fewer than 2 pairs), and the median
+    planning ms per step."""
     base = _baseline_name()
     rows = []
     for (model, H, method, family), g in closed.groupby(
         ["model", "H", "method", "family"], sort=False
     ):
         w = _paired(model, closed)
-        d = (w[(H, method)] - w[(H, base)]).dropna().to_numpy(float)
+        pair = w[list(dict.fromkeys([(H, method), (H, base)]))].dropna()
+        d = (pair[(H, method)] - pair[(H, base)]).to_numpy(float)
         key = {"model": model, "H": int(H), "method": method}
-        if d.size >= 2 and method != base:
+        if method == base:
+            lo = hi = 0.0
+        elif d.size >= 2:
             rng = job_rng(seed, "horizon_closed", **key)
             idx = rng.integers(0, d.size, size=(n_boot, d.size))
             lo, hi = (float(v) for v in np.quantile(d[idx].mean(axis=1), [0.025, 0.975]))
         else:
-            lo = hi = float(d.mean()) if d.size else float("nan")
+            lo = hi = float("nan")
         rows.append(
             {
                 **key,
                 "family": family,
-                "runs": len(g),
-                "mean_error": float(g["mean_error"].mean()),
+                "runs": int(d.size),
+                "mean_error": float(pair[(H, method)].mean()),
                 "error_diff": float(d.mean()) if d.size else float("nan"),
                 "error_diff_low": lo,
                 "error_diff_high": hi,
@@ -339,9 +371,10 @@ def advantage_growth(
         for m in (method, base):
             if (h, m) not in w.columns:
                 raise ValueError(f"no closed-loop runs of {m!r} at H = {h} on {model!r}")
-    d_lo = w[(h_lo, method)] - w[(h_lo, base)]
-    d_hi = w[(h_hi, method)] - w[(h_hi, base)]
-    D = (d_hi - d_lo).dropna().to_numpy(float)
+    both = w[[(h_lo, method), (h_lo, base), (h_hi, method), (h_hi, base)]].dropna()
+    d_lo = both[(h_lo, method)] - both[(h_lo, base)]
+    d_hi = both[(h_hi, method)] - both[(h_hi, base)]
+    D = (d_hi - d_lo).to_numpy(float)
     if D.size < 2:
         raise ValueError(f"{method!r} on {model!r}: {D.size} paired run(s)")
     rng = job_rng(seed, "horizon_advantage", model=model, method=method, h_lo=h_lo, h_hi=h_hi)

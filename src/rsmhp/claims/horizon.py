@@ -1,4 +1,4 @@
-r"""UAV horizon study, claims HZ-1-<model> and HZ-2-<model>: each a key number from
+r"""UAV horizon study, claims HZ-1-<model>, HZ-2-<model> and HZ-3-<model>: each a key number from
 :mod:`rsmhp.analysis.horizon` and a verdict rule (:mod:`rsmhp.verdicts`). All claims are
 beyond the paper (part "beyond"): the paper plans at H = 6 only. Key numbers are statistical
 (sampled hypotheses, optimiser-free but random). H_lo and H_hi are the smallest and largest
@@ -12,10 +12,11 @@ horizons of ``horizon.uav.H``.
   mean error of the Monte-Carlo member − NBO's at H_hi) − (the same at H_lo), paired over
   runs (the same scenarios at both H; m). The advantage of sampling over NBO grows with H:
   *supported* if the CI of D lies below 0, *not supported* above 0, *inconclusive* otherwise.
-* **HZ-2** (:func:`hz2_rule`): d = g(pruned tree) − g(Monte Carlo with as many trajectories),
-  the members fixed in ``horizon.uav.claims``. The pruned tree's error grows with H more than
-  Monte Carlo's: *supported* if the CI of d lies above 0, *not supported* below 0,
-  *inconclusive* otherwise.
+* **HZ-2** (:func:`hz2_rule`): d = g(pruned tree) − g(Monte Carlo with N_T = M), the
+  members fixed in ``horizon.uav.claims``, from the smallest H at which the tree is pruned
+  (N^(H+1) > M leaves, so it keeps M trajectories, as many as Monte Carlo) to H_hi. The
+  pruned tree's error grows with H more than Monte Carlo's: *supported* if the CI of d lies
+  above 0, *not supported* below 0, *inconclusive* otherwise.
 """
 
 from __future__ import annotations
@@ -48,7 +49,7 @@ def hz1_rule(h_lo: int, h_hi: int) -> Rule:
         0.0,
         claimed="above",
         basis=f"g = relative RMSE of NBO's cost estimate at H = {h_hi} − at H = {h_lo}, the same "
-        "belief states (bootstrap over states)",
+        "belief states (bootstrap over runs)",
     )
 
 
@@ -59,7 +60,7 @@ def hz2_rule(tree: str, mc: str, h_lo: int, h_hi: int) -> Rule:
         0.0,
         claimed="above",
         basis=f"g = growth of the relative RMSE from H = {h_lo} to {h_hi} of "
-        f"{method_label(tree)} − that of {method_label(mc)} (bootstrap over states)",
+        f"{method_label(tree)} − that of {method_label(mc)} (bootstrap over runs)",
     )
 
 
@@ -146,6 +147,7 @@ def horizon_claims(
         (cfg.get("claims", {}) or {}).get("tree"),
         (cfg.get("claims", {}) or {}).get("monte_carlo"),
     )
+    tree_lo = _pruned_from(tree, hs) if tree else None
     out: list[Claim] = []
     for model in dict.fromkeys(summary["model"]):
         s = summary[summary["model"] == model]
@@ -173,19 +175,20 @@ def horizon_claims(
                     setup=setup,
                 )
             )
-        if tree and mc and {tree, mc} <= present:
-            d = rmse_growth(approx, model, tree, h_lo, h_hi, seed, n_boot, minus=mc)
-            g_mc = rmse_growth(approx, model, mc, h_lo, h_hi, seed, n_boot)
-            rule = hz2_rule(tree, mc, h_lo, h_hi)
+        if tree and mc and {tree, mc} <= present and tree_lo is not None and tree_lo < h_hi:
+            d = rmse_growth(approx, model, tree, tree_lo, h_hi, seed, n_boot, minus=mc)
+            g_mc = rmse_growth(approx, model, mc, tree_lo, h_hi, seed, n_boot)
+            rule = hz2_rule(tree, mc, tree_lo, h_hi)
             out.append(
                 Claim(
                     f"HZ-2-{model}",
                     f"On '{model}', the error of {method_label(tree)} grows with the horizon "
-                    f"more than that of {method_label(mc)} (as many trajectories)",
+                    f"more than that of {method_label(mc)} (both M trajectories, H = {tree_lo} "
+                    f"to {h_hi})",
                     src + "Sec. II proposes pruning to keep the tree's N^H trajectories "
                     "tractable as H grows",
                     _key(
-                        f"RMSE growth H = {h_lo} → {h_hi}, {method_label(tree)} − "
+                        f"RMSE growth H = {tree_lo} → {h_hi}, {method_label(tree)} − "
                         f"{method_label(mc)}",
                         d,
                     ),
@@ -194,14 +197,34 @@ def horizon_claims(
                     measured=f"{d.n} belief states; relative RMSE of {method_label(tree)} "
                     f"{fmt(100 * d.lo_value, 3)}% → {fmt(100 * d.hi_value, 3)}%, of "
                     f"{method_label(mc)} {fmt(100 * g_mc.lo_value, 3)}% → "
-                    f"{fmt(100 * g_mc.hi_value, 3)}% (H = {h_lo} → {h_hi})",
+                    f"{fmt(100 * g_mc.hi_value, 3)}% (H = {tree_lo} → {h_hi}; from H = "
+                    f"{tree_lo} the tree has more than M leaves, so it is pruned)",
                     part="beyond",
-                    setup=setup,
+                    setup=f"UAV '{model}', belief states of NBO runs, H = {tree_lo} to {h_hi}",
                 )
             )
-    closed_model = (cfg.get("claims", {}) or {}).get("closed_model") or ""
-    if closed is not None and closed_model and mc and not closed.empty:
-        sel = closed[closed["model"] == closed_model]
-        if {h_lo, h_hi} <= set(sel["H"]) and mc in set(sel["method"]):
-            out.append(_hz3(closed, closed_model, mc, h_lo, h_hi, seed, n_boot))
+    out += _hz3_claims(closed, cfg, mc, seed, n_boot)
     return out
+
+
+def _pruned_from(tree: str, hs: list[int]) -> int | None:
+    """The smallest horizon of ``hs`` at which ``tree`` has more than M leaves (N^(H+1) > M,
+    so it is pruned and keeps M trajectories), or None."""
+    m = registry.from_name(tree)
+    pruned = [h for h in hs if m.n_branch ** (h + 1) > m.max_keep]
+    return pruned[0] if pruned else None
+
+
+def _hz3_claims(
+    closed: pd.DataFrame | None, cfg: Mapping[str, Any], mc: str | None, seed: int, n_boot: int
+) -> list[Claim]:
+    """HZ-3 on ``horizon.uav.claims.closed_model``, between the smallest and largest H of the
+    closed-loop rows (none if either is missing)."""
+    model = (cfg.get("claims", {}) or {}).get("closed_model") or ""
+    if closed is None or closed.empty or not model or not mc:
+        return []
+    sel = closed[closed["model"] == model]
+    hs = sorted(int(h) for h in sel["H"].unique())
+    if len(hs) < 2 or mc not in set(sel["method"]):
+        return []
+    return [_hz3(closed, model, mc, hs[0], hs[-1], seed, n_boot)]

@@ -19,10 +19,12 @@ horizon ``uav.planner.horizon``, so every H sees the same belief states) and com
   (:func:`rsmhp.experiments.decisions_uav.score_state`); its planning time is measured by a
   second, timed plan call with its own stream after it (milliseconds, one thread).
 
-Random streams are keyed on (model, run, step, H, method, replicate): a row never depends on
-the other methods, horizons or models, so jobs can run in any order. The regret reuses the
-decision study's streams, keyed on (model, run, step) and the method: at every H the plans
-are scored on evaluation hypotheses from the same stream (common random numbers across H).
+Random streams are keyed on (model, run, step, H, method, replicate): a cost-approximation
+row or a timing never depends on the other methods, horizons or models, so jobs can run in
+any order. The regret rows reuse the decision study's scoring and streams (keyed on model,
+run, step and the method; the same stream at every H, of which only the initial-state draws
+coincide across H); their reference, the best plan found, starts from every method's plan,
+so a regret depends on the set of methods.
 """
 
 from __future__ import annotations
