@@ -10,7 +10,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-__all__ = ["escape", "fmt", "fmt_ci", "markdown_table", "param_text", "range_text"]
+__all__ = ["ci_cells", "escape", "fmt", "fmt_ci", "markdown_table", "param_text", "range_text"]
 
 
 def fmt(x: float | int, digits: int = 3, signed: bool = False) -> str:
@@ -45,6 +45,17 @@ def fmt_ci(lo: float, hi: float, digits: int = 3, signed: bool = False) -> str:
         s = "+" if signed else ""
         return f"[{float(lo):{s}.{decimals}f}, {float(hi):{s}.{decimals}f}]"
     return f"[{fmt(lo, digits, signed)}, {fmt(hi, digits, signed)}]"
+
+
+def ci_cells(lows, highs, scale: float = 1.0, digits: int = 3, signed: bool = False) -> list[str]:
+    """Table cells ``[lo, hi]`` (:func:`fmt_ci` of ``scale`` times each limit), one per row of
+    the two sequences; ``undefined`` where either limit is not finite (no CI)."""
+    return [
+        fmt_ci(scale * lo, scale * hi, digits, signed)
+        if math.isfinite(lo) and math.isfinite(hi)
+        else "undefined"
+        for lo, hi in zip(lows, highs, strict=True)
+    ]
 
 
 def escape(text: str) -> str:

@@ -143,10 +143,8 @@ def horizon_claims(
         return []
     h_lo, h_hi, n_boot = hs[0], hs[-1], int(cfg["bootstrap"])
     base = registry.baseline()().name
-    tree, mc = (
-        (cfg.get("claims", {}) or {}).get("tree"),
-        (cfg.get("claims", {}) or {}).get("monte_carlo"),
-    )
+    rules = cfg.get("claims", {}) or {}
+    tree, mc = rules.get("tree"), rules.get("monte_carlo")
     tree_lo = _pruned_from(tree, hs) if tree else None
     out: list[Claim] = []
     for model in dict.fromkeys(summary["model"]):

@@ -44,6 +44,7 @@ from rsmhp.experiments.decisions_uav import (
     _REGRET_NULLABLE,
     REGRET_COLUMNS,
     BeliefState,
+    _positions,
     belief_states,
     merge_variant,
     score_state,
@@ -166,7 +167,7 @@ def _approx_rows(
     ref = PlanningProblem(state.uav, state.P_hat, ref_xy, *args)
     per_hyp = fused.covariance_traces(
         state.P_hat,
-        np.stack([ref.path(x)[:, :2] for x in plans]),
+        _positions(plans, ref),
         ref_xy,
         setup.target.dt,
         setup.target.Q,

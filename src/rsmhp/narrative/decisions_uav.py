@@ -8,7 +8,6 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
 from rsmhp.analysis.decisions_uav import (
@@ -24,21 +23,13 @@ from rsmhp.analysis.decisions_uav import (
 from rsmhp.analysis.uav import baseline_name
 from rsmhp.claims.decisions_uav import pp, uav_claims
 from rsmhp.ledger import Claim, Section
-from rsmhp.markdown import fmt, fmt_ci, markdown_table, param_text
+from rsmhp.markdown import ci_cells, fmt, fmt_ci, markdown_table, param_text
 from rsmhp.palette import method_label
 
 __all__ = ["FIGURES", "uav_decision_section", "uav_tables"]
 
 #: figure stems of the section (the figure rule writes them; see decisions.smk)
 FIGURES = ("dec_uav_regret", "dec_uav_map")
-
-
-def _ci_cells(lows: pd.Series, highs: pd.Series, scale: float, signed: bool = False) -> list:
-    """``[lo, hi]`` per row (times ``scale``), ``undefined`` where the CI is absent."""
-    return [
-        fmt_ci(scale * lo, scale * hi, 3, signed=signed) if np.isfinite(lo) else "undefined"
-        for lo, hi in zip(lows, highs, strict=True)
-    ]
 
 
 def _regret_table(summary: pd.DataFrame) -> str:
@@ -48,7 +39,7 @@ def _regret_table(summary: pd.DataFrame) -> str:
             "method": summary["method"].map(method_label),
             "states": summary["n_states"].astype(int),
             "regret %": 100 * summary["mean_regret_rel"],
-            "95% CI": _ci_cells(summary["ci_low"], summary["ci_high"], 100),
+            "95% CI": ci_cells(summary["ci_low"], summary["ci_high"], 100),
             "median %": 100 * summary["median_regret_rel"],
             "states > 2 SE %": (100 * summary["frac_significant"]).round(1),
             "vs best method %": 100 * summary["mean_regret_methods_rel"],
@@ -75,7 +66,7 @@ def _map_table(map_df: pd.DataFrame) -> str:
             ],
             "runs": map_df["n_runs"].astype(int),
             "mean diff (m)": map_df["mean_diff"],
-            "95% CI (m)": _ci_cells(map_df["ci_low"], map_df["ci_high"], 1, signed=True),
+            "95% CI (m)": ci_cells(map_df["ci_low"], map_df["ci_high"], 1, signed=True),
             "p": map_df["p_value"],
             "loss NBO %": (100 * map_df["loss_nbo"]).round(1),
             "loss method %": (100 * map_df["loss_method"]).round(1),

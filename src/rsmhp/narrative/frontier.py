@@ -8,14 +8,13 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
 from rsmhp.analysis.frontier import budget_check
 from rsmhp.claims.frontier import frontier_claims
 from rsmhp.figures.frontier import FIGURES
 from rsmhp.ledger import Claim, Section
-from rsmhp.markdown import fmt, fmt_ci, markdown_table, param_text
+from rsmhp.markdown import ci_cells, fmt, fmt_ci, markdown_table, param_text
 from rsmhp.palette import method_label
 from rsmhp.uav import methods as registry
 from rsmhp.uav.methods.tree_search import ALPHA_A, ALPHA_O, C_UCB, K_A, K_O
@@ -24,13 +23,6 @@ __all__ = ["FIGURES", "TABLES", "frontier_section", "frontier_tables"]
 
 #: table stems of the section (the summary rule writes them; see frontier.smk)
 TABLES = ("dec_frontier", "dec_frontier_budget")
-
-
-def _ci(lo: pd.Series, hi: pd.Series, digits: int = 3, signed: bool = True) -> list[str]:
-    return [
-        fmt_ci(a, b, digits, signed) if np.isfinite(a) and np.isfinite(b) else "undefined"
-        for a, b in zip(lo, hi, strict=True)
-    ]
 
 
 def _frontier_table(summary: pd.DataFrame) -> str:
@@ -42,12 +34,16 @@ def _frontier_table(summary: pd.DataFrame) -> str:
             "runs": summary["runs"].astype(int),
             "error (m)": summary["mean_error"],
             "− NBO (m)": summary["error_diff"],
-            "95% CI (m)": _ci(summary["error_diff_low"], summary["error_diff_high"]),
+            "95% CI (m)": ci_cells(
+                summary["error_diff_low"], summary["error_diff_high"], signed=True
+            ),
             "lost %": (100 * summary["lost_rate"]).round(1),
             "states": summary["states"].astype(int),
             "regret %": summary["regret_pct"],
             "− NBO (pp)": summary["regret_diff_pp"],
-            "95% CI (pp)": _ci(summary["regret_diff_pp_low"], summary["regret_diff_pp_high"]),
+            "95% CI (pp)": ci_cells(
+                summary["regret_diff_pp_low"], summary["regret_diff_pp_high"], signed=True
+            ),
         }
     )
     return markdown_table(t, digits=3, missing="undefined", signed=("− NBO (m)", "− NBO (pp)"))

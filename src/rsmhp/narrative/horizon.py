@@ -14,19 +14,12 @@ import pandas as pd
 from rsmhp.claims.horizon import horizon_claims
 from rsmhp.figures.horizon import FIGURES
 from rsmhp.ledger import Claim, Section
-from rsmhp.markdown import fmt, fmt_ci, markdown_table
+from rsmhp.markdown import ci_cells, fmt, fmt_ci, markdown_table
 from rsmhp.palette import method_label
 
 __all__ = ["FIGURES", "TABLES", "horizon_section", "horizon_tables"]
 
 TABLES = ("hz_uav_approx", "hz_uav_regret", "hz_uav_closed", "hz_lqg")
-
-
-def _ci(lo: pd.Series, hi: pd.Series) -> list[str]:
-    return [
-        fmt_ci(100 * a, 100 * b, 3) if np.isfinite(a) and np.isfinite(b) else "undefined"
-        for a, b in zip(lo, hi, strict=True)
-    ]
 
 
 def horizon_tables(
@@ -48,9 +41,9 @@ def horizon_tables(
             "method": a["method"].map(method_label),
             "states": a["states"].astype(int),
             "bias %": 100 * a["rel_bias"],
-            "95% CI": _ci(a["rel_bias_low"], a["rel_bias_high"]),
+            "95% CI": ci_cells(a["rel_bias_low"], a["rel_bias_high"], 100),
             "RMSE %": 100 * a["rel_rmse"],
-            "95% CI ": _ci(a["rel_rmse_low"], a["rel_rmse_high"]),
+            "95% CI ": ci_cells(a["rel_rmse_low"], a["rel_rmse_high"], 100),
             "reference SE %": 100 * a["ref_noise"],
             "Spearman": a["spearman"],
             "constant": a["spearman_undefined"].astype(int),
@@ -92,10 +85,7 @@ def horizon_tables(
             "runs": c["runs"].astype(int),
             "error (m)": c["mean_error"],
             "− NBO (m)": c["error_diff"],
-            "95% CI (m)": [
-                fmt_ci(a, b, 3, True)
-                for a, b in zip(c["error_diff_low"], c["error_diff_high"], strict=True)
-            ],
+            "95% CI (m)": ci_cells(c["error_diff_low"], c["error_diff_high"], signed=True),
             "ms/step": c["plan_ms"],
         }
     )
