@@ -118,6 +118,7 @@ def test_families_and_the_published_job_keys():
     assert [c.family for c in methods.families()] == [
         "nbo",
         "rsmhp",
+        "rsmhp_per_step",
         "tree",
         "rqmc",
         "antithetic",
@@ -191,3 +192,35 @@ def test_every_family_draws_valid_hypotheses(rng):
             for j in range(H):
                 x = x @ F.T + hyp.noise[:, j + 1]
                 np.testing.assert_allclose(hyp.states[:, j], x, rtol=1e-12, atol=1e-9)
+
+
+def test_monte_carlo_per_step_draws_k_h_independent_futures():
+    """rsmhp_nt<k>h: N_T = k H hypotheses at every horizon, equal weights, the Monte-Carlo
+    draw (same stream gives the same futures as rsmhp_nt<kH>), its own stream key."""
+    from rsmhp.uav.methods.monte_carlo_per_step import MonteCarloPerStep
+
+    m = methods.from_config({"rsmhp_nt_per_step": [3]}, "x")["rsmhp_nt3h"]
+    assert isinstance(m, MonteCarloPerStep) and m.name == "rsmhp_nt3h"
+    assert methods.from_name("rsmhp_nt3h") == m and methods.from_spec(m.spec()) == m
+    assert methods.from_name("rsmhp_nt3").family == "rsmhp"  # the fixed-N_T family keeps its names
+    assert m.columns() == {"N_T": 0, "N": 0, "M": 0}
+    assert m.job_key()["per_step"] == 3 and m.job_key()["method"] == "rsmhp_nt3h"
+    belief = Belief(np.array([0.0, 0.0, 20.0, 0.0]), np.array([300.0, 0, 5, 0]), np.eye(4))
+    for H in (2, 5):
+        cfg = copy.deepcopy(CONFIG["uav"])
+        cfg["planner"]["horizon"] = H
+        setup = UAVSetup.from_config(cfg)
+        hyp = m.hypotheses(belief, setup, np.random.default_rng(7))
+        assert hyp.states.shape == (3 * H, H, 4) and m.n_traj_at(H) == 3 * H
+        np.testing.assert_array_equal(hyp.weights, np.full(3 * H, 1 / (3 * H)))
+        fixed = methods.from_name(f"rsmhp_nt{3 * H}").hypotheses(
+            belief, setup, np.random.default_rng(7)
+        )
+        np.testing.assert_array_equal(hyp.states, fixed.states)
+    with pytest.raises(ValueError, match=r"x\.rsmhp_nt_per_step\[0\] must be >= 1, got 0"):
+        methods.from_config({"rsmhp_nt_per_step": [0]}, "x")
+    assert methods.sort_names(["rsmhp_nt3h", "rsmhp_nt500", "nbo"]) == [
+        "nbo",
+        "rsmhp_nt500",
+        "rsmhp_nt3h",
+    ]

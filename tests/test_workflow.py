@@ -377,8 +377,50 @@ def test_horizon_outputs(run_j2, tiny):
     for name in ("hz_uav_error", "hz_uav_time", "hz_uav_closed"):
         assert (run_j2 / f"results/paper/figures/{name}.png").read_bytes()[:4] == b"\x89PNG"
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
-    for table in ("hz_uav_approx", "hz_uav_regret", "hz_uav_closed", "hz_lqg"):
+    for table in ("hz_uav_approx", "hz_uav_regret", "hz_uav_closed", "hz_lqg",
+                  "hz_lqg_estimators", "hz_lqg_regret"):  # fmt: skip
         assert (run_j2 / f"results/tables/{table}.md").read_text().strip() in appendix
+    # the N_T ∝ H member has 2 H hypotheses at every H (tiny: rsmhp_nt_per_step [2])
+    assert "rsmhp_nt2h" in set(summary["method"])
+    assert "Runs needed (closed loop):" in report
+
+
+def test_horizon_lqg_outputs(run_j2, tiny):
+    """Oven LQG at long horizons: estimator and regret rows, their summaries, HZ-4/HZ-5 in the
+    report with their rules, the figure."""
+    cfg = tiny["horizon"]["lqg"]
+    est = pd.read_csv(run_j2 / "results/horizon/lqg_estimators.csv")
+    assert set(est["H"]) == set(cfg["sim_H"]) and set(est["scheme"]) == {
+        "nbo", "cubature", "mc", "sobol", "pruned"}  # fmt: skip
+    pruned = est[est["scheme"] == "pruned"]
+    assert (pruned["N"] ** pruned["H"] > pruned["M"]).all()
+    reg = pd.read_csv(run_j2 / "results/horizon/lqg_regret_summary.csv")
+    assert set(reg["H"]) == set(cfg["sim_H"]) and reg["limit"].notna().any()
+    report = (run_j2 / "results/paper/replication.md").read_text()
+    for cid in ("HZ-4", "HZ-5"):
+        assert f"| {cid} |" in report
+    assert (run_j2 / "results/paper/figures/hz_lqg.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_horizon_recording_replays_run_of_the_config(run_j2, tiny):
+    """horizon.uav.recording: one member per family at the configured H and run, each with its
+    map and hypotheses (the tree search has none); the replay equals the closed-loop row."""
+    rec = tiny["horizon"]["uav"]["recording"]
+    log = (run_j2 / "results/logs/horizon_recording.log").read_text()
+    closed = pd.read_csv(run_j2 / f"results/horizon/uav/{rec['model']}_H{rec['H']}_closed.csv")
+    families = list(dict.fromkeys(closed["family"]))
+    path = run_j2 / f"results/recordings/hz_{rec['model']}_H{rec['H']}.rrd"
+    entities = set()
+    for chunk in RrdReader(path).store().stream():
+        entities.add(str(chunk.entity_path))
+    one = closed[closed["run"] == rec["run"]].groupby("family", sort=False)["method"].last()
+    assert list(one.index) == families
+    for family, m in one.items():
+        assert f"/{m}/map/plan" in entities and f"/{m}/map/uav_path" in entities
+        if family != "dpw":
+            assert f"/{m}/map/hypotheses" in entities
+        row = closed[(closed["run"] == rec["run"]) & (closed["method"] == m)].iloc[0]
+        assert f"{m}: mean error {row['mean_error']:.2f} m" in log
 
 
 def test_frontier_recording_replays_the_run_its_rule_chooses(run_j2, tiny):

@@ -210,6 +210,7 @@ def _cross_field(config: Mapping[str, Any]) -> list[str]:
         val = (lqg.get("model", {}) or {}).get(key)
         if isinstance(val, float) and not math.isfinite(val):
             problems.append(f"lqg.model.{key}: {val} is not finite")
+    problems += _horizon_lqg_problems((config.get("horizon", {}) or {}).get("lqg", {}) or {})
     problems += _nothing_to_run(config)
     problems += _uav_cross_field(config.get("uav", {}) or {})
     problems += _decisions_cross_field(config)
@@ -394,6 +395,25 @@ def _horizon_problems(config: Mapping[str, Any], names: list, n_steps: int) -> l
             f"{path}.claims.closed_model: {closed!r} is not a model of {path}.models "
             f"(allowed: {', '.join(models) or 'none configured'}, or '')"
         )
+    rec = hz.get("recording", {}) or {}
+    if rec.get("model"):
+        if rec["model"] not in models:
+            problems.append(
+                f"{path}.recording.model: {rec['model']!r} is not a model of {path}.models "
+                f"(allowed: {', '.join(models) or 'none configured'}, or '')"
+            )
+        hs = [h for h in hz.get("H", []) or [] if isinstance(h, int)]
+        if "H" in rec and rec["H"] not in hs:
+            problems.append(
+                f"{path}.recording.H: {rec['H']} is not a horizon of {path}.H (allowed: "
+                f"{', '.join(map(str, hs))})"
+            )
+        n_closed = hz.get("closed_runs")
+        if isinstance(n_closed, int) and isinstance(rec.get("run"), int) and rec["run"] >= n_closed:
+            problems.append(
+                f"{path}.recording.run: {rec['run']} is not a closed-loop run (allowed: 0 <= "
+                f"run < {path}.closed_runs = {n_closed})"
+            )
     for key, family in (("tree", PrunedTree), ("monte_carlo", MonteCarlo)):
         name = claims.get(key) or ""
         ok = [n for n, m in run.items() if isinstance(m, family)]
@@ -401,6 +421,44 @@ def _horizon_problems(config: Mapping[str, Any], names: list, n_steps: int) -> l
             problems.append(
                 f"{path}.claims.{key}: {name!r} is not a {family.__name__} member of "
                 f"{path}.methods (allowed: {', '.join(ok) or 'none configured'}, or '')"
+            )
+    return problems
+
+
+def _horizon_lqg_problems(hz: Mapping[str, Any]) -> list[str]:
+    """``horizon.lqg``: Sobol' sizes are powers of 2, and HZ-4's pruned tree is a cell of
+    the estimator grid that is pruned at some configured horizon."""
+    path = "horizon.lqg"
+    est = hz.get("estimators", {}) or {}
+    ns = [n for n in est.get("n", []) or [] if isinstance(n, int)]
+    problems = [
+        f"{path}.estimators.n: {n} is not a power of 2 (allowed: 2, 4, 8, ... for Sobol')"
+        for n in ns
+        if n & (n - 1)
+    ]
+    tree = (hz.get("claims", {}) or {}).get("pruned", {}) or {}
+    if not tree:
+        return problems
+    N, M = tree.get("N"), tree.get("M")
+    n_list = [N_ for N_ in est.get("pruned_N", []) or [] if isinstance(N_, int)]
+    if N not in n_list:
+        problems.append(
+            f"{path}.claims.pruned.N: {N!r} is not in {path}.estimators.pruned_N (allowed: "
+            f"{', '.join(map(str, n_list)) or 'none configured'})"
+        )
+    if M not in ns:
+        problems.append(
+            f"{path}.claims.pruned.M: {M!r} is not in {path}.estimators.n (allowed: "
+            f"{', '.join(map(str, ns)) or 'none configured'})"
+        )
+    hs = sorted(h for h in hz.get("sim_H", []) or [] if isinstance(h, int))
+    if isinstance(N, int) and isinstance(M, int) and hs:
+        pruned = [h for h in hs if N**h > M]
+        if len(pruned) < 2:
+            problems.append(
+                f"{path}.claims.pruned: N = {N}, M = {M} is pruned (N^H > M) at "
+                f"{len(pruned)} of {path}.sim_H = {hs} (allowed: at least 2 such horizons, "
+                "HZ-4 compares the first with the last)"
             )
     return problems
 

@@ -6,6 +6,12 @@ With :math:`b = 1-a` and :math:`S_H = \sum_{n=0}^{H-1} b^{2n} = (1-b^{2H})/(1-b^
 * **NBO's error** :math:`r v_H = r\sigma^2 S_H` grows with H to the limit
   :math:`r\sigma^2/(1-b^2)` (:func:`nbo_error_limit`); its relative gap to the limit is
   :math:`b^{2H}`.
+* **Monte Carlo's decision regret** (:func:`rsmhp.lqg.expected_regret`, the sample-average
+  argmin over P independent sequences) :math:`\kappa_H v_H / P` with :math:`\kappa_H = r^2
+  a^2 S_H / (1 + r a^2 S_H)` and :math:`v_H = \sigma^2 S_H` tends to
+  :math:`\kappa_\infty v_\infty / P` with :math:`S_\infty = 1/(1-b^2)`
+  (:func:`mc_regret_limit`); with likeliness weights the first-order regret carries an
+  extra :math:`(4/3)^{H/2}/3` and has no limit.
 * **The paper's problem** (terminal cost :math:`r(x_H-T)^2 + \sum u_k^2`). Its optimal first
   control is :math:`u_0 = L_H (T - b^H x_0)` with :math:`L_H = r a b^{H-1}/(1 + r a^2 S_H)`
   (:func:`first_control_gain`; the open-loop optimum is also the first control of the
@@ -34,6 +40,7 @@ from rsmhp import guards
 
 __all__ = [
     "first_control_gain",
+    "mc_regret_limit",
     "nbo_error_limit",
     "stage_cost_gains",
     "stationary_gain",
@@ -53,6 +60,18 @@ def nbo_error_limit(*, a: float, r: float, sigma: float) -> float:
     r = guards.real("r", r, lo=0.0, lo_open=True)
     sigma = guards.real("sigma", sigma, lo=0.0)
     return r * sigma**2 / (1.0 - b * b)
+
+
+def mc_regret_limit(P: int, *, a: float, r: float, sigma: float) -> float:
+    r""":math:`\lim_{H\to\infty} \kappa_H v_H / P = r^2 a^2 \sigma^2 S_\infty^2 / ((1 + r a^2
+    S_\infty) P)`, :math:`S_\infty = 1/(1-(1-a)^2)`: the mean regret of uniform Monte Carlo
+    with P trajectories at long horizons."""
+    a, b = _ab(a)
+    r = guards.real("r", r, lo=0.0, lo_open=True)
+    sigma = guards.real("sigma", sigma, lo=0.0)
+    P = guards.positive_int("P", P)
+    S = 1.0 / (1.0 - b * b)
+    return r * r * a * a * sigma**2 * S * S / ((1.0 + r * a * a * S) * P)
 
 
 def first_control_gain(H: int | np.ndarray, *, a: float, r: float) -> float | np.ndarray:

@@ -17,6 +17,7 @@ PRIORITY = {
     "decisions_uav": 990,
     "decisions_frontier": 980,
     "horizon_uav": 970,
+    "horizon_lqg": 960,
     "estimators_summary": 100,
     "lqg_convergence": 100,
     "lqg_nbo_error": 100,

@@ -1,12 +1,22 @@
 # Long horizons (horizon.uav): one job per model variant and horizon H with every method's
 # cost estimate against a reference sample, its open-loop regret and its planning time
-# (one thread), then aggregation, claims and report section, and the figures.
+# (one thread), paired closed-loop runs per (model, H); the oven LQG (horizon.lqg): cost
+# estimators and decision regret at long horizons against exact oracles; then aggregation,
+# claims and report section, and the figures.
 from rsmhp.figures.horizon import FIGURES as HORIZON_FIGURES
 from rsmhp.narrative.horizon import TABLES as HORIZON_TABLES
 
 HZ = config["horizon"]["uav"]
+HZL = config["horizon"]["lqg"]
+HZL_MODEL = pick(config["lqg"]["model"], "x0", "r", "target", "sigma")
 HZ_MODELS = list(HZ["models"])
 HZ_JOBS = [f"{m}_H{h}" for m in HZ_MODELS for h in HZ["H"]]
+HZ_REC = HZ.get("recording", {}) or {}
+HZ_RECORDING = (
+    [f"results/recordings/hz_{HZ_REC['model']}_H{HZ_REC['H']}.rrd"]
+    if HZ_MODELS and HZ_REC.get("model")
+    else []
+)
 if HZ_MODELS:
     REPORT_SECTIONS["horizon_uav"] = "results/report/horizon_uav.json"
     REPORT_FIGURES.extend(HORIZON_FIGURES)
@@ -69,44 +79,98 @@ rule horizon_uav_closed:
         "../scripts/horizon_uav_closed.py"
 
 
-rule horizon_uav_summary:
-    """UAV horizon study: statistics by horizon, tables, claims HZ-1/HZ-2, report section."""
-    input:
-        approx=expand("results/horizon/uav/{job}_approx.csv", job=HZ_JOBS),
-        regret=expand("results/horizon/uav/{job}_regret.csv", job=HZ_JOBS),
-        closed=expand("results/horizon/uav/{job}_closed.csv", job=HZ_JOBS),
+rule horizon_lqg_estimators:
+    """Oven LQG at long horizons: pruned trees, Monte Carlo, RQMC, NBO and sigma points against the exact cost."""
     output:
-        approx="results/horizon/uav_approx_summary.csv",
-        regret="results/horizon/uav_regret_summary.csv",
-        closed="results/horizon/uav_closed_summary.csv",
-        tables=table_outputs(HORIZON_TABLES, "Long horizons"),
-        section="results/report/horizon_uav.json",
+        "results/horizon/lqg_estimators.csv",
     log:
-        "results/logs/horizon_uav_summary.log",
+        "results/logs/horizon_lqg_estimators.log",
     benchmark:
-        "results/benchmarks/horizon_uav_summary.tsv"
+        "results/benchmarks/horizon_lqg_estimators.tsv"
+    priority: PRIORITY["horizon_lqg"]
+    conda:
+        ENV
+    threads: 2
+    resources:
+        mem_mb=3000,
+        runtime=30,
+    params:
+        cfg=pick(HZL, "sim_a", "sim_H", "replicates", "estimators"),
+        model=HZL_MODEL,
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/horizon_lqg_estimators.py"),
+    script:
+        "../scripts/horizon_lqg_estimators.py"
+
+
+rule horizon_lqg_regret:
+    """Oven LQG at long horizons: decision regret of every method's exact sample-average argmin."""
+    output:
+        "results/horizon/lqg_regret.csv",
+    log:
+        "results/logs/horizon_lqg_regret.log",
+    benchmark:
+        "results/benchmarks/horizon_lqg_regret.tsv"
+    priority: PRIORITY["horizon_lqg"]
     conda:
         ENV
     threads: 1
     resources:
-        mem_mb=2000,
+        mem_mb=3000,
+        runtime=30,
+    params:
+        cfg=pick(HZL, "sim_a", "sim_H", "replicates", "regret"),
+        model=HZL_MODEL,
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/horizon_lqg_regret.py"),
+    script:
+        "../scripts/horizon_lqg_regret.py"
+
+
+rule horizon_summary:
+    """Long horizons: statistics by horizon (UAV and oven LQG), tables, claims HZ-1..HZ-5, report section."""
+    input:
+        approx=expand("results/horizon/uav/{job}_approx.csv", job=HZ_JOBS),
+        regret=expand("results/horizon/uav/{job}_regret.csv", job=HZ_JOBS),
+        closed=expand("results/horizon/uav/{job}_closed.csv", job=HZ_JOBS),
+        lqg_estimators="results/horizon/lqg_estimators.csv",
+        lqg_regret="results/horizon/lqg_regret.csv",
+    output:
+        approx="results/horizon/uav_approx_summary.csv",
+        regret="results/horizon/uav_regret_summary.csv",
+        closed="results/horizon/uav_closed_summary.csv",
+        lqg_estimators="results/horizon/lqg_estimators_summary.csv",
+        lqg_regret="results/horizon/lqg_regret_summary.csv",
+        tables=table_outputs(HORIZON_TABLES, "Long horizons"),
+        section="results/report/horizon_uav.json",
+    log:
+        "results/logs/horizon_summary.log",
+    benchmark:
+        "results/benchmarks/horizon_summary.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=3000,
         runtime=10,
     params:
         cfg=canonical(HZ),
-        lqg=canonical(config["horizon"]["lqg"]),
-        lqg_model=pick(config["lqg"]["model"], "a", "r", "sigma"),
+        lqg=canonical(HZL),
+        lqg_model=pick(config["lqg"]["model"], "a", "x0", "r", "target", "sigma"),
         seed=config["seed"],
-        code=code_digest("workflow/scripts/horizon_uav_summary.py"),
+        code=code_digest("workflow/scripts/horizon_summary.py"),
     script:
-        "../scripts/horizon_uav_summary.py"
+        "../scripts/horizon_summary.py"
 
 
 rule horizon_figures:
-    """UAV horizon study figures: cost-approximation error, planning time and regret against H."""
+    """Long-horizon figures: cost-approximation error, planning time, regret and closed loop against H (UAV and oven LQG)."""
     input:
         approx="results/horizon/uav_approx_summary.csv",
         regret="results/horizon/uav_regret_summary.csv",
         closed="results/horizon/uav_closed_summary.csv",
+        lqg_estimators="results/horizon/lqg_estimators_summary.csv",
+        lqg_regret="results/horizon/lqg_regret_summary.csv",
     output:
         figure_outputs(HORIZON_FIGURES, "Long horizons"),
     log:
@@ -125,8 +189,36 @@ rule horizon_figures:
         "../scripts/horizon_figures.py"
 
 
+rule horizon_recording:
+    """Rerun recording of one closed-loop run at a long horizon (horizon.uav.recording): one member per family, hypotheses and plans."""
+    input:
+        closed=f"results/horizon/uav/{HZ_REC.get('model')}_H{HZ_REC.get('H')}_closed.csv",
+    output:
+        HZ_RECORDING,
+    log:
+        "results/logs/horizon_recording.log",
+    benchmark:
+        "results/benchmarks/horizon_recording.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=15,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(config["decisions"]["uav"]["models"]),
+        cfg=pick(HZ, "closed_runs", "methods"),
+        recording=canonical(HZ_REC),
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/horizon_recording.py"),
+    script:
+        "../scripts/horizon_recording.py"
+
+
 rule horizon:
     """Target: the long-horizon study (nothing when no model is configured)."""
     input:
-        rules.horizon_uav_summary.output if HZ_MODELS else [],
+        rules.horizon_summary.output if HZ_MODELS else [],
         rules.horizon_figures.output if HZ_MODELS else [],
+        HZ_RECORDING,

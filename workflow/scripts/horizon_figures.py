@@ -1,16 +1,19 @@
-"""Rule horizon_figures: the UAV horizon study's figures (PNG + PDF)."""
+"""Rule horizon_figures: the long-horizon study's figures (PNG + PDF)."""
 
 from pathlib import Path
 
+from rsmhp.analysis.decisions_lqg import LQG_SUMMARY_COLUMNS
 from rsmhp.analysis.horizon import (
     APPROX_SUMMARY_COLUMNS,
     CLOSED_SUMMARY_COLUMNS,
     REGRET_SUMMARY_COLUMNS,
 )
+from rsmhp.analysis.horizon_lqg import LQG_ESTIMATOR_COLUMNS
 from rsmhp.figures import save_figure
 from rsmhp.figures.horizon import (
     horizon_closed_figure,
     horizon_error_figure,
+    horizon_lqg_figure,
     horizon_time_figure,
 )
 from rsmhp.io import read_table
@@ -24,3 +27,6 @@ with rule_logging(snakemake):
     save_figure(horizon_time_figure(regret), outdir / "hz_uav_time")
     closed = read_table(snakemake.input.closed, CLOSED_SUMMARY_COLUMNS)
     save_figure(horizon_closed_figure(closed), outdir / "hz_uav_closed")
+    est = read_table(snakemake.input.lqg_estimators, LQG_ESTIMATOR_COLUMNS)
+    reg = read_table(snakemake.input.lqg_regret, [*LQG_SUMMARY_COLUMNS, "limit"])
+    save_figure(horizon_lqg_figure(est, reg), outdir / "hz_lqg")

@@ -26,6 +26,7 @@ the median planning milliseconds.
 
 from __future__ import annotations
 
+import math
 from typing import NamedTuple
 
 import numpy as np
@@ -44,6 +45,7 @@ __all__ = [
     "advantage_growth",
     "lqg_horizon_table",
     "rmse_growth",
+    "runs_to_resolve",
     "state_errors",
     "summarize_approx",
     "summarize_closed",
@@ -297,6 +299,8 @@ CLOSED_SUMMARY_COLUMNS = [
     "error_diff",
     "error_diff_low",
     "error_diff_high",
+    "diff_sd",
+    "runs_to_resolve",
     "plan_ms",
 ]
 
@@ -310,8 +314,9 @@ def _paired(model: str, closed: pd.DataFrame) -> pd.DataFrame:
 def summarize_closed(closed: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFrame:
     """Per (model, H, method), over the runs that pair with NBO's: their number, the mean
     location error (m), the paired difference method − NBO with its 95% percentile-bootstrap
-    CI (stream keyed on model, H, method; NaN with fewer than 2 pairs), and the median
-    planning ms per step."""
+    CI (stream keyed on model, H, method; NaN with fewer than 2 pairs), the SD of the paired
+    differences over runs, the runs a CI would need to exclude 0 if the mean difference
+    stayed as it is (:func:`runs_to_resolve`) and the median planning ms per step."""
     base = _baseline_name()
     rows = []
     for (model, H, method, family), g in closed.groupby(
@@ -321,6 +326,7 @@ def summarize_closed(closed: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFra
         pair = w[list(dict.fromkeys([(H, method), (H, base)]))].dropna()
         d = (pair[(H, method)] - pair[(H, base)]).to_numpy(float)
         key = {"model": model, "H": int(H), "method": method}
+        sd = float(d.std(ddof=1)) if d.size >= 2 else float("nan")
         if method == base:
             lo = hi = 0.0
         elif d.size >= 2:
@@ -338,10 +344,24 @@ def summarize_closed(closed: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFra
                 "error_diff": float(d.mean()) if d.size else float("nan"),
                 "error_diff_low": lo,
                 "error_diff_high": hi,
+                "diff_sd": 0.0 if method == base else sd,
+                "runs_to_resolve": float("nan")
+                if method == base
+                else runs_to_resolve(float(d.mean()) if d.size else float("nan"), sd),
                 "plan_ms": float(g["plan_ms"].median()),
             }
         )
     return pd.DataFrame(rows, columns=CLOSED_SUMMARY_COLUMNS)
+
+
+def runs_to_resolve(mean: float, sd: float) -> float:
+    r""":math:`\lceil (1.96\, s / |\bar d|)^2 \rceil`: the paired runs at which a normal 95%
+    CI of half-width :math:`1.96 s/\sqrt n` would just exclude 0 around a mean difference
+    :math:`\bar d` with SD :math:`s` over runs (the sample size a comparison needs to resolve
+    the difference it measured; NaN for :math:`\bar d = 0` or a NaN input; at least 2)."""
+    if not (np.isfinite(mean) and np.isfinite(sd)) or mean == 0.0:
+        return float("nan")
+    return float(max(2, math.ceil((1.96 * sd / abs(mean)) ** 2)))
 
 
 class Advantage(NamedTuple):

@@ -63,6 +63,7 @@ __all__ = [
     "closed_contract",
     "horizon_contracts",
     "horizon_setup",
+    "recording_members",
     "run_horizon",
     "run_horizon_closed",
 ]
@@ -99,6 +100,15 @@ def horizon_setup(uav: Mapping[str, Any], model: Mapping[str, Any], H: int) -> U
 
 def _names(cfg: Mapping[str, Any]) -> dict[str, Method]:
     return methods.from_config(cfg["methods"], "horizon.uav.methods")
+
+
+def recording_members(cfg: Mapping[str, Any]) -> list[Method]:
+    """One member per family of ``horizon.uav.methods``, the last in table order (the
+    largest: most hypotheses or simulations), in table order: the recording's methods."""
+    last: dict[str, Method] = {}
+    for m in _names(cfg).values():
+        last[m.family] = m
+    return list(last.values())
 
 
 def horizon_contracts(cfg: Mapping[str, Any], model: str, H: int) -> tuple[Contract, Contract]:

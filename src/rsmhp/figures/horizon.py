@@ -8,6 +8,12 @@ relative bias (%). ``hz_uav_time``: top row the median planning milliseconds per
 best cost: the part of the regret due to the cost approximation). x: the horizon H (log
 scale). ``hz_uav_closed``: the closed-loop mean location error minus NBO's on the same runs
 (m, 95% bootstrap CIs over runs). One line per method in its palette colour.
+
+``hz_lqg`` (oven LQG, exact oracle; one row per simulated a): left, the relative RMSE (%,
+log scale) of each cost estimator with n trajectories (the largest n of the study: Monte
+Carlo, RQMC, the pruned trees keeping M = n, one shade per N) and NBO, 95% bootstrap CIs over
+replicates; right, the mean regret of uniform Monte Carlo per P with its 95% t-CI, the closed
+form κ_H v_H / P (dashed) and its limit κ_∞ v_∞ / P (dotted), log scale.
 """
 
 from __future__ import annotations
@@ -18,12 +24,18 @@ import pandas as pd
 from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLocator
 
 from rsmhp.figures import theme
-from rsmhp.palette import method_colour, method_label
+from rsmhp.palette import METHOD_COLOURS, method_colour, method_label, size_shade
 from rsmhp.uav import methods as _registry  # noqa: F401  (UAV method names get their colours)
 
-__all__ = ["FIGURES", "horizon_closed_figure", "horizon_error_figure", "horizon_time_figure"]
+__all__ = [
+    "FIGURES",
+    "horizon_closed_figure",
+    "horizon_error_figure",
+    "horizon_lqg_figure",
+    "horizon_time_figure",
+]
 
-FIGURES = ["hz_uav_error", "hz_uav_time", "hz_uav_closed"]
+FIGURES = ["hz_uav_error", "hz_uav_time", "hz_uav_closed", "hz_lqg"]
 
 #: relative RMSEs below this (%) are drawn at it (the log axis has no 0)
 RMSE_FLOOR_PCT = 1e-3
@@ -110,3 +122,92 @@ def horizon_closed_figure(closed_summary: pd.DataFrame) -> plt.Figure:
     """``hz_uav_closed`` from :func:`rsmhp.analysis.horizon.summarize_closed`."""
     rows = [("error_diff", "closed-loop mean error − NBO's (m)", False, None)]
     return _grid(closed_summary, rows, "Closed loop against NBO, by horizon")
+
+
+_LQG_SCHEMES = {"nbo": "NBO", "mc": "Monte Carlo", "sobol": "RQMC (Sobol')"}
+
+
+def horizon_lqg_figure(est_summary: pd.DataFrame, regret_summary: pd.DataFrame) -> plt.Figure:
+    """``hz_lqg`` from :func:`rsmhp.analysis.horizon_lqg.summarize_lqg_estimators` and
+    :func:`rsmhp.analysis.horizon_lqg.summarize_lqg_horizon_regret` (module doc)."""
+    theme()
+    a_vals = sorted(float(a) for a in est_summary["a"].unique())
+    if not a_vals:
+        raise ValueError("LQG horizon summary is empty")
+    e = est_summary[est_summary["weighting"].isin(["uniform", "nominal"])]
+    n = int(e.loc[e["scheme"] == "mc", "n_trajectories"].max())
+    hs = sorted(int(h) for h in e["H"].unique())
+    fig, axes = plt.subplots(
+        len(a_vals), 2, figsize=(9.6, 3.4 * len(a_vals)), squeeze=False, sharex=True
+    )
+    for i, a in enumerate(a_vals):
+        ax = axes[i, 0]
+        ea = e[e["a"] == a]
+        curves = [(s, 0, _LQG_SCHEMES[s], method_colour(s)) for s in _LQG_SCHEMES]
+        curves += [
+            (
+                "pruned",
+                int(N),
+                f"pruned tree N = {int(N)}, M = {n}",
+                size_shade(METHOD_COLOURS["pruned"], 4 * int(N), edges=(8, 16, 64, 128)),
+            )
+            for N in sorted(ea.loc[ea["scheme"] == "pruned", "N"].unique())
+        ]
+        for scheme, N, label, colour in curves:
+            g = ea[(ea["scheme"] == scheme) & (ea["N"] == N)]
+            if scheme != "nbo":
+                g = g[g["n_trajectories"] == n]
+            g = g.sort_values("H")
+            if g.empty:
+                continue
+            y = 100 * g["rel_rmse"].to_numpy(float)
+            err = np.vstack(
+                [
+                    np.maximum(y - 100 * g["rel_rmse_low"].to_numpy(float), 0),
+                    np.maximum(100 * g["rel_rmse_high"].to_numpy(float) - y, 0),
+                ]
+            )
+            style = {"ls": "--", "zorder": 5, "marker": "s"} if scheme == "nbo" else {}
+            ax.errorbar(g["H"], y, yerr=err, color=colour, ms=3.5, lw=1.3, capsize=2,
+                        label=label, **{"marker": "o", **style})  # fmt: skip
+        ax.set_yscale("log")
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(NullFormatter())
+        ax.set_ylabel(f"a = {a:g}: relative RMSE of Ĵ (%)")
+        _h_axis(ax, hs)
+        ax = axes[i, 1]
+        r = regret_summary[
+            (regret_summary["a"] == a)
+            & (regret_summary["method"] == "mc")
+            & (regret_summary["weighting"] == "uniform")
+        ]
+        ps = sorted(int(p) for p in r["P"].unique())
+        for P in ps:
+            g = r[r["P"] == P].sort_values("H")
+            colour = size_shade(METHOD_COLOURS["mc"], P, edges=(16, 32, 64, 128))
+            y = g["mean"].to_numpy(float)
+            err = np.vstack(
+                [
+                    np.maximum(y - g["ci_low"].to_numpy(float), 0),
+                    np.maximum(g["ci_high"].to_numpy(float) - y, 0),
+                ]
+            )
+            ax.errorbar(g["H"], y, yerr=err, color=colour, marker="o", ms=3.5, lw=0,
+                        elinewidth=1.0, capsize=2, label=f"Monte Carlo P = {P}")  # fmt: skip
+            ax.plot(g["H"], g["closed_form"], color=colour, ls="--", lw=1.0)
+            ax.axhline(float(g["limit"].iloc[-1]), color=colour, ls=":", lw=1.0)
+        ax.set_yscale("log")
+        ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+        ax.yaxis.set_minor_formatter(NullFormatter())
+        ax.set_ylabel("mean regret J(û) − J(u*)")
+        _h_axis(ax, hs)
+        if i == 0:
+            axes[0, 0].set_title(f"cost estimators, n = {n} trajectories")
+            axes[0, 1].set_title("decisions: --- κ_H v_H / P, ··· limit H → ∞")
+            axes[0, 0].legend(fontsize="x-small", loc="best")
+            ax.legend(fontsize="x-small", loc="best")
+    for ax in axes[-1]:
+        ax.set_xlabel("horizon H (steps)")
+    fig.suptitle("Oven LQG at long horizons (exact oracle)", fontsize=11)
+    fig.tight_layout()
+    return fig

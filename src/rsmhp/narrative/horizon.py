@@ -11,7 +11,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rsmhp.claims.horizon import horizon_claims
+from rsmhp.claims.horizon import horizon_claims, lqg_horizon_claims
 from rsmhp.figures.horizon import FIGURES
 from rsmhp.ledger import Claim, Section
 from rsmhp.markdown import ci_cells, fmt, fmt_ci, markdown_table
@@ -19,7 +19,14 @@ from rsmhp.palette import method_label
 
 __all__ = ["FIGURES", "TABLES", "horizon_section", "horizon_tables"]
 
-TABLES = ("hz_uav_approx", "hz_uav_regret", "hz_uav_closed", "hz_lqg")
+TABLES = (
+    "hz_uav_approx",
+    "hz_uav_regret",
+    "hz_uav_closed",
+    "hz_lqg",
+    "hz_lqg_estimators",
+    "hz_lqg_regret",
+)
 
 
 def horizon_tables(
@@ -27,12 +34,19 @@ def horizon_tables(
     regret_summary: pd.DataFrame,
     lqg_table: pd.DataFrame,
     closed_summary: pd.DataFrame,
+    lqg_estimators: pd.DataFrame,
+    lqg_regret: pd.DataFrame,
 ) -> dict[str, str]:
     """Markdown tables ``hz_uav_approx`` (per model, H and method: relative bias and RMSE of
     the cost estimate in percent with CIs, the reference's relative SE, rank correlation),
     ``hz_uav_regret`` (relative regret against the best plan found and against the best of the
     methods' plans, planning ms), ``hz_uav_closed`` (closed-loop error and its paired
-    difference with NBO) and ``hz_lqg`` (:func:`rsmhp.analysis.horizon.lqg_horizon_table`)."""
+    difference with NBO, the runs a CI would need to exclude 0), ``hz_lqg``
+    (:func:`rsmhp.analysis.horizon.lqg_horizon_table`), ``hz_lqg_estimators`` (oven LQG: relative
+    bias and RMSE of each estimator against the exact J by a and H,
+    :func:`rsmhp.analysis.horizon_lqg.summarize_lqg_estimators`) and ``hz_lqg_regret`` (mean
+    regret with CI, closed form, its limit and z,
+    :func:`rsmhp.analysis.horizon_lqg.summarize_lqg_horizon_regret`)."""
     a = approx_summary
     t1 = pd.DataFrame(
         {
@@ -86,14 +100,49 @@ def horizon_tables(
             "error (m)": c["mean_error"],
             "− NBO (m)": c["error_diff"],
             "95% CI (m)": ci_cells(c["error_diff_low"], c["error_diff_high"], signed=True),
+            "SD over runs (m)": c["diff_sd"],
+            "runs to exclude 0": c["runs_to_resolve"],
             "ms/step": c["plan_ms"],
+        }
+    )
+    e = lqg_estimators
+    t5 = pd.DataFrame(
+        {
+            "a": e["a"],
+            "H": e["H"].astype(int),
+            "scheme": e["scheme"],
+            "weighting": e["weighting"],
+            "N": e["N"].astype(int),
+            "n": e["n_trajectories"].astype(int),
+            "bias %": 100 * e["rel_bias"],
+            "RMSE %": 100 * e["rel_rmse"],
+            "95% CI": ci_cells(e["rel_rmse_low"], e["rel_rmse_high"], 100),
+            "closed form %": 100 * e["rel_rmse_theory"],
+        }
+    )
+    g = lqg_regret
+    t6 = pd.DataFrame(
+        {
+            "a": g["a"],
+            "H": g["H"].astype(int),
+            "method": g["method"],
+            "weighting": g["weighting"],
+            "P": g["P"].astype(int),
+            "mean regret": g["mean"],
+            "95% CI": ci_cells(g["ci_low"], g["ci_high"]),
+            "closed form": g["closed_form"],
+            "limit H → ∞": g["limit"],
+            "z": g["z"],
+            "regret / J*": g["rel_mean"],
         }
     )
     return {
         "hz_uav_approx": markdown_table(t1, digits=3, missing="undefined", signed=("bias %",)),
         "hz_uav_regret": markdown_table(t2, digits=3),
-        "hz_uav_closed": markdown_table(t4, digits=3, signed=("− NBO (m)",)),
+        "hz_uav_closed": markdown_table(t4, digits=3, missing="–", signed=("− NBO (m)",)),
         "hz_lqg": markdown_table(t3, digits=4),
+        "hz_lqg_estimators": markdown_table(t5, digits=3, missing="–", signed=("bias %",)),
+        "hz_lqg_regret": markdown_table(t6, digits=3, missing="–"),
     }
 
 
@@ -121,6 +170,102 @@ def _lqg_text(q: pd.DataFrame, a_model: float, eps: float) -> str:
     )
 
 
+def _lqg_sim_text(est: pd.DataFrame, reg: pd.DataFrame, a_model: float) -> str:
+    """The simulated oven LQG at long horizons (tables hz_lqg_estimators, hz_lqg_regret), at
+    the model's a (or the nearest simulated a)."""
+    if est.empty:
+        return ""
+    a_vals = np.unique(est["a"].to_numpy(float))
+    a = float(a_vals[np.argmin(np.abs(a_vals - a_model))])
+    e = est[(est["a"] == a) & (est["weighting"].isin(["uniform", "nominal"]))]
+    hs = sorted(int(h) for h in e["H"].unique())
+    h_lo, h_hi = hs[0], hs[-1]
+
+    def rmse(scheme: str, h: int, n: int, N: int = 0) -> str:
+        row = e[
+            (e["scheme"] == scheme) & (e["H"] == h) & (e["n_trajectories"] == n) & (e["N"] == N)
+        ]
+        return f"{fmt(100 * float(row['rel_rmse'].iloc[0]), 3)}%" if len(row) else "–"
+
+    n_max = int(e.loc[e["scheme"] == "mc", "n_trajectories"].max())
+    trees = e[(e["scheme"] == "pruned") & (e["n_trajectories"] == n_max)]
+    nbo = e[e["scheme"] == "nbo"].set_index("H")["rel_rmse"]
+    parts = [
+        f"Simulated oven LQG (a = {fmt(a, 2)}, controls u*(H), exact J): with n = {n_max} "
+        f"trajectories the relative RMSE of Monte Carlo is {rmse('mc', h_lo, n_max)} at H = "
+        f"{h_lo} and {rmse('mc', h_hi, n_max)} at H = {h_hi}, of RQMC "
+        f"{rmse('sobol', h_lo, n_max)} and {rmse('sobol', h_hi, n_max)} (its advantage shrinks "
+        f"as the dimension H grows); NBO's is {fmt(100 * float(nbo.loc[h_lo]), 3)}% and "
+        f"{fmt(100 * float(nbo.loc[h_hi]), 3)}%."
+    ]
+    for N in sorted(int(x) for x in trees["N"].unique()):
+        t = trees[trees["N"] == N].set_index("H")["rel_rmse"]
+        parts.append(
+            f"The pruned tree with N = {N} draws per level keeping M = {n_max}: "
+            + ", ".join(f"{fmt(100 * float(v), 3)}% at H = {int(h)}" for h, v in t.items())
+            + "."
+        )
+    g = reg[(reg["a"] == a)]
+    mc = g[(g["method"] == "mc") & (g["weighting"] == "uniform")]
+    w = g[(g["method"] == "mc") & (g["weighting"] == "likeliness")]
+    if not mc.empty:
+        p_max = int(mc["P"].max())
+        m1 = mc[mc["P"] == p_max].set_index("H")
+        parts.append(
+            f"Decisions: uniform Monte Carlo's mean regret at P = {p_max} is "
+            + ", ".join(f"{fmt(float(m1.loc[h, 'mean']), 3)}" for h in (h_lo, h_hi))
+            + f" at H = {h_lo}, {h_hi} (closed forms "
+            + ", ".join(f"{fmt(float(m1.loc[h, 'closed_form']), 3)}" for h in (h_lo, h_hi))
+            + f"; limit {fmt(float(m1.loc[h_hi, 'limit']), 3)}); NBO, antithetic pairs and "
+            "sigma points have zero regret at every H (their samples' mean final-state noise "
+            "is 0)."
+        )
+    if not w.empty:
+        bad = w[w["z"].abs() > 3.0]
+        if len(bad):
+            worst = bad.loc[bad["z"].abs().idxmax()]
+            parts.append(
+                "The likeliness-weighted Monte-Carlo regret leaves its first-order form "
+                "κ v_H (4/3)^(H/2)/(3P) at long horizons (the weights' effective sample size "
+                f"falls like (3/4)^(H/2) P): |z| > 3 in {len(bad)} of {len(w)} cells, worst "
+                f"z = {fmt(float(worst['z']), 3, True)} at H = {int(worst['H'])}, P = "
+                f"{int(worst['P'])} (mean {fmt(float(worst['mean']), 3)} vs "
+                f"{fmt(float(worst['closed_form']), 3)})."
+            )
+    return " ".join(parts)
+
+
+def _runs_text(closed_summary: pd.DataFrame) -> str:
+    """How many runs the closed-loop comparisons used and would need (column 'runs to
+    exclude 0' of hz_uav_closed)."""
+    c = closed_summary[closed_summary["runs_to_resolve"].notna()]
+    if c.empty:
+        return ""
+    out = []
+    for model, g in c.groupby("model", sort=False):
+        half = (g["error_diff_high"] - g["error_diff_low"]) / 2
+        resolved = (g["error_diff_low"] > 0) | (g["error_diff_high"] < 0)
+        need = g.loc[~resolved, "runs_to_resolve"]
+        rest = (
+            f"; the other {len(need)} would need {int(need.min())} to {int(need.max())} runs "
+            f"(median {int(need.median())})"
+            if len(need)
+            else ""
+        )
+        out.append(
+            f"'{model}': {int(g['runs'].min())} paired runs per comparison with NBO, CI "
+            f"half-widths {fmt(float(half.min()), 2)} to {fmt(float(half.max()), 2)} m; "
+            f"{int(resolved.sum())} of {len(g)} CIs exclude 0{rest}"
+        )
+    return (
+        "Runs needed (closed loop): "
+        + "; ".join(out)
+        + ". Table hz_uav_closed gives per comparison 'runs to exclude 0' = (1.96 SD / |mean "
+        "difference|)², the runs at which the CI would just exclude 0 if the mean difference "
+        "and its SD over runs stayed as measured."
+    )
+
+
 def _setting(cfg: Mapping[str, Any], hs: Sequence[int]) -> str:
     return (
         f"H ∈ {{{', '.join(str(h) for h in hs)}}} on "
@@ -138,14 +283,22 @@ def _setting(cfg: Mapping[str, Any], hs: Sequence[int]) -> str:
     )
 
 
-def _findings(claims: Sequence[Claim], a: pd.DataFrame, r: pd.DataFrame) -> str:
+def _claim_lines(claims: Sequence[Claim]) -> str:
+    """``ID (verdict): key value unit [CI].`` per claim (no CI for a bitwise number)."""
     out = []
     for c in claims:
         k = c.key
+        ci = f" {fmt_ci(k.ci_low, k.ci_high, k.digits, True)}" if k.ci_low is not None else ""
+        signed = k.null is not None
         out.append(
-            f"{c.id} ({c.verdict}): {k.name} {fmt(k.value, k.digits, True)} {k.unit} "
-            f"{fmt_ci(k.ci_low, k.ci_high, k.digits, True)}."
+            f"{c.id} ({c.verdict}): {k.name} {fmt(k.value, k.digits, signed)} {k.unit}".rstrip()
+            + f"{ci}."
         )
+    return " ".join(out)
+
+
+def _findings(claims: Sequence[Claim], a: pd.DataFrame, r: pd.DataFrame) -> str:
+    out = [_claim_lines(claims)] if claims else []
     h_hi = max(int(h) for h in a["H"].unique())
     for model, s in a[a["H"] == h_hi].groupby("model", sort=False):
         ranked = s.sort_values("rel_rmse")
@@ -165,6 +318,15 @@ def _findings(claims: Sequence[Claim], a: pd.DataFrame, r: pd.DataFrame) -> str:
         )
     return " ".join(out)
 
+
+_LQG_FIGURE = [
+    "![Oven LQG at long horizons](figures/hz_lqg.png)",
+    "",
+    "*Oven LQG, exact oracle: relative RMSE of each cost estimator against H (log scale; "
+    "n = M trajectories for Monte Carlo, RQMC and the pruned trees) and the mean decision "
+    "regret of Monte Carlo against H with its closed form κ_H v_H / P and the limit "
+    "κ_∞ v_∞ / P; bars: 95% CIs.*",
+]
 
 _FIGURE = [
     "![Closed loop by horizon](figures/hz_uav_closed.png)",
@@ -196,10 +358,20 @@ def horizon_section(
     lqg_cfg: Mapping[str, Any],
     a_model: float,
     closed: pd.DataFrame | None = None,
+    closed_summary: pd.DataFrame | None = None,
+    lqg_est: pd.DataFrame | None = None,
+    lqg_est_summary: pd.DataFrame | None = None,
+    lqg_regret_summary: pd.DataFrame | None = None,
 ) -> Section:
     """The horizon study's report section (order 33); ``cfg`` is ``horizon.uav``,
-    ``lqg_cfg`` ``horizon.lqg``, ``a_model`` the oven model's a (``lqg.model.a``)."""
+    ``lqg_cfg`` ``horizon.lqg``, ``a_model`` the oven model's a (``lqg.model.a``); the LQG
+    simulation rows and summaries of :mod:`rsmhp.analysis.horizon_lqg` (omitted: no HZ-4/5)."""
     claims = horizon_claims(approx, approx_summary, cfg, seed, closed)
+    empty = pd.DataFrame()
+    est = lqg_est if lqg_est is not None else empty
+    est_s = lqg_est_summary if lqg_est_summary is not None else empty
+    reg_s = lqg_regret_summary if lqg_regret_summary is not None else empty
+    lqg_claims = lqg_horizon_claims(est, reg_s, lqg_cfg, a_model, seed)
     hs = sorted(int(h) for h in cfg["H"])
     body = "\n".join(
         [
@@ -207,11 +379,20 @@ def horizon_section(
             "",
             _findings(claims, approx_summary, regret_summary),
             "",
+            _runs_text(closed_summary) if closed_summary is not None else "",
+            "",
             _lqg_text(lqg_table, a_model, float(lqg_cfg["eps"])),
             "",
+            _claim_lines(lqg_claims),
+            "",
+            _lqg_sim_text(est_s, reg_s, a_model),
+            "",
             *_FIGURE,
+            "",
+            *(_LQG_FIGURE if not est_s.empty else []),
         ]
     )
+    claims = [*claims, *lqg_claims]
     appendix = "\n".join(
         [
             "Cost approximation per model, horizon and method (relative bias and RMSE of the "
@@ -245,6 +426,20 @@ def horizon_section(
             "is within eps of it:",
             "",
             tables["hz_lqg"],
+            "",
+            "Oven LQG simulated at long horizons (controls u*(H), exact J; "
+            "`rsmhp.experiments.horizon_lqg`): relative bias and RMSE of each cost estimator "
+            "in percent of J with the RMSE's 95% bootstrap CI over replicates, and uniform "
+            "Monte Carlo's closed form √(Var g / n)/J; n = trajectories (M kept for a pruned "
+            "tree with N draws per level, run only where N^H > M); '–': no closed form:",
+            "",
+            tables["hz_lqg_estimators"],
+            "",
+            "Decision regret J(û) − J(u*) of the sample-average argmin at long horizons (mean "
+            "over replicates with t-CI, closed form, its limit as H → ∞, z of the mean against "
+            "the closed form; '–': none):",
+            "",
+            tables["hz_lqg_regret"],
         ]
     )
     return Section(

@@ -1,4 +1,5 @@
-"""Rule horizon_uav_summary: statistics of the UAV horizon study, tables, claims, section."""
+"""Rule horizon_summary: statistics of the long-horizon study (UAV and oven LQG), tables,
+claims, section."""
 
 from pathlib import Path
 
@@ -10,8 +11,13 @@ from rsmhp.analysis.horizon import (
     summarize_closed,
     summarize_horizon_regret,
 )
+from rsmhp.analysis.horizon_lqg import (
+    summarize_lqg_estimators,
+    summarize_lqg_horizon_regret,
+)
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.horizon import closed_contract, horizon_contracts
+from rsmhp.experiments.horizon_lqg import estimator_contract, regret_contract
 from rsmhp.io import write_csv, write_text
 from rsmhp.narrative.horizon import horizon_section, horizon_tables
 from rsmhp.pipeline import rule_logging
@@ -34,16 +40,23 @@ with rule_logging(snakemake) as log:
     a_sum = summarize_approx(approx, p.seed, int(p.cfg["bootstrap"]))
     r_sum = summarize_horizon_regret(regret)
     lq, model = p.lqg, p.lqg_model
+    est = read_checked(snakemake.input.lqg_estimators, estimator_contract(lq, model))
+    reg = read_checked(snakemake.input.lqg_regret, regret_contract(lq))
+    est_sum = summarize_lqg_estimators(est, lq, model, p.seed)
+    reg_sum = summarize_lqg_horizon_regret(reg, model)
     lqg_table = lqg_horizon_table(
         lq["a_values"], lq["H"], r=model["r"], sigma=model["sigma"], eps=lq["eps"]
     )
-    tables = horizon_tables(a_sum, r_sum, lqg_table, c_sum)
+    tables = horizon_tables(a_sum, r_sum, lqg_table, c_sum, est_sum, reg_sum)
     section = horizon_section(
-        approx, a_sum, r_sum, tables, p.cfg, p.seed, lqg_table, lq, model["a"], closed
-    )
+        approx, a_sum, r_sum, tables, p.cfg, p.seed, lqg_table, lq, model["a"], closed,
+        c_sum, est, est_sum, reg_sum,
+    )  # fmt: skip
     write_csv(a_sum, snakemake.output.approx)
     write_csv(r_sum, snakemake.output.regret)
     write_csv(c_sum, snakemake.output.closed)
+    write_csv(est_sum, snakemake.output.lqg_estimators)
+    write_csv(reg_sum, snakemake.output.lqg_regret)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
     section.save(snakemake.output.section)
