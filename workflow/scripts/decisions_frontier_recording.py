@@ -9,7 +9,7 @@ from rsmhp.experiments.frontier import frontier_contracts, recording_setup
 from rsmhp.pipeline import rule_logging
 from rsmhp.uav.methods import baseline
 from rsmhp.uav.methods.monte_carlo import MonteCarlo
-from rsmhp.uav.recording import check_replay, record_uav_run
+from rsmhp.uav.recording import record_checked_run
 
 with rule_logging(snakemake) as log:
     p = snakemake.params
@@ -26,21 +26,14 @@ with rule_logging(snakemake) as log:
         f"{rec['select']} on d_r = mean location error of {compare} − {base} over the "
         f"frontier's runs (this run: d = {d:+.3f} m)."
     )
-    rows, summaries = record_uav_run(
+    record_checked_run(
         snakemake.output[0],
         setup,
         methods,
+        runs,
         seed=p.seed,
         run=run,
         max_hypotheses=int(rec["max_hypotheses"]),
         note=note,
+        log=log,
     )
-    check_replay(summaries, runs[runs["run"] == run])
-    for s in summaries:
-        log.info(
-            "%s: mean error %.2f m, detections %.0f%%",
-            s["method"],
-            s["mean_error"],
-            100 * s.get("detect_rate", 1.0),
-        )
-    log.info("logged %d entities, %d rows", len(rows), sum(rows.values()))

@@ -4,7 +4,7 @@ planning step with the hypotheses' predicted tracks and the plan (rerun recordin
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.horizon import closed_contract, horizon_setup, recording_members
 from rsmhp.pipeline import rule_logging
-from rsmhp.uav.recording import check_replay, record_uav_run
+from rsmhp.uav.recording import record_checked_run
 
 with rule_logging(snakemake) as log:
     p = snakemake.params
@@ -21,16 +21,14 @@ with rule_logging(snakemake) as log:
         "(their predicted target tracks) and the planned UAV path. The tree search plans over "
         "simulated beliefs and has no hypotheses to show."
     )
-    rows, summaries = record_uav_run(
+    record_checked_run(
         snakemake.output[0],
         setup,
         methods,
+        closed,
         seed=p.seed,
         run=run,
         max_hypotheses=int(rec["max_hypotheses"]),
         note=note,
+        log=log,
     )
-    check_replay(summaries, closed[closed["run"] == run])
-    for s in summaries:
-        log.info("%s: mean error %.2f m", s["method"], s["mean_error"])
-    log.info("logged %d entities, %d rows", len(rows), sum(rows.values()))

@@ -55,6 +55,7 @@ __all__ = [
     "grid_points",
     "n_trajectories",
     "run_ablation",
+    "run_points",
 ]
 
 log = logging.getLogger(__name__)
@@ -349,17 +350,20 @@ def _task(job) -> list[dict]:
     return out
 
 
-def run_ablation(
-    cfg: Mapping[str, Any], lqg_model: Mapping[str, Any], seed: int, n_jobs: int = 1
+def run_points(
+    points: list[GridPoint],
+    specs: Mapping[str, Mapping[str, Any]],
+    lqg_model: Mapping[str, Any],
+    seed: int,
+    reps: int,
+    n_jobs: int = 1,
+    label: str = "estimators",
 ) -> pd.DataFrame:
-    """Run the whole grid of the ``estimators`` config section; one row per estimate."""
-    specs = {
-        spec["name"]: {k: v for k, v in spec.items() if k != "name"} for spec in cfg["problems"]
-    }
+    """The rows (:data:`ABLATION_COLUMNS`, in task order) of every grid point of ``points``
+    with ``reps`` replicates, on ``n_jobs`` workers; ``specs`` maps problem names to their
+    config entries. The largest cells go first, dealt round-robin into ``4 n_jobs`` tasks:
+    rows never depend on it (each cell's streams are keyed on the cell)."""
     problems = {name: build_problem(spec, lqg_model) for name, spec in specs.items()}
-    points = grid_points(cfg, problems)
-    reps = int(cfg["replicates"])
-    # expensive cells first, then round-robin into 4*n_jobs tasks (results never depend on it)
     weight = {
         p: (
             max(p.n, p.N ** problems[p.problem].H if p.M == 0 else p.N * p.M, 1)
@@ -371,15 +375,28 @@ def run_ablation(
     n_tasks = max(1, min(len(points), 4 * n_jobs))
     jobs = [(ordered[i::n_tasks], specs, dict(lqg_model), seed, reps) for i in range(n_tasks)]
     log.info(
-        "estimators: %d problems, %d grid points, %d replicates, %d tasks on %d workers",
+        "%s: %d problems, %d grid points, %d replicates, %d tasks on %d workers",
+        label,
         len(problems),
         len(points),
         reps,
         len(jobs),
         n_jobs,
     )
-    rows = [r for part in parallel_map(_task, jobs, n_jobs, desc="ablation tasks") for r in part]
-    df = pd.DataFrame(rows, columns=ABLATION_COLUMNS)
+    rows = [r for part in parallel_map(_task, jobs, n_jobs, desc=f"{label} tasks") for r in part]
+    return pd.DataFrame(rows, columns=ABLATION_COLUMNS)
+
+
+def run_ablation(
+    cfg: Mapping[str, Any], lqg_model: Mapping[str, Any], seed: int, n_jobs: int = 1
+) -> pd.DataFrame:
+    """Run the whole grid of the ``estimators`` config section; one row per estimate."""
+    specs = {
+        spec["name"]: {k: v for k, v in spec.items() if k != "name"} for spec in cfg["problems"]
+    }
+    problems = {name: build_problem(spec, lqg_model) for name, spec in specs.items()}
+    points = grid_points(cfg, problems)
+    df = run_points(points, specs, lqg_model, seed, int(cfg["replicates"]), n_jobs)
     order = {name: i for i, name in enumerate(specs)}
     df = df.assign(_p=df["problem"].map(order))
     df = df.sort_values(

@@ -43,12 +43,11 @@ from rsmhp.experiments.estimators import (
     ABLATION_COLUMNS,
     GridPoint,
     _weightings,
-    ablation_rows,
     build_problem,
     n_trajectories,
+    run_points,
 )
 from rsmhp.linear_quadratic import LinearQuadratic
-from rsmhp.parallel import parallel_map
 
 __all__ = [
     "estimator_contract",
@@ -131,15 +130,6 @@ def estimator_contract(cfg: Mapping[str, Any], model: Mapping[str, Any]) -> Cont
     )
 
 
-def _estimator_task(job) -> list[dict]:
-    points, specs, model, seed, reps = job
-    out = []
-    for p in points:
-        spec = specs[p.problem]
-        out.extend(ablation_rows(p, build_problem(spec, model), spec, seed, reps))
-    return out
-
-
 def run_lqg_estimators(
     cfg: Mapping[str, Any], model: Mapping[str, Any], seed: int, n_jobs: int = 1
 ) -> pd.DataFrame:
@@ -148,22 +138,9 @@ def run_lqg_estimators(
     specs = problem_specs(cfg, model)
     problems = {n: build_problem(s, model) for n, s in specs.items()}
     points = estimator_points(cfg, problems)
-    reps = int(cfg["replicates"])
-    # the largest cells first, dealt round-robin (never changes a number)
-    work = {p: max(p.n, p.N * p.M, 1) * problems[p.problem].H for p in points}
-    ordered = sorted(points, key=lambda p: -work[p])
-    n_tasks = max(1, min(len(points), 4 * n_jobs))
-    jobs = [(ordered[i::n_tasks], specs, dict(model), seed, reps) for i in range(n_tasks)]
-    log.info(
-        "horizon_lqg_estimators: %d problems, %d cells x %d replicates in %d tasks on %d workers",
-        len(problems),
-        len(points),
-        reps,
-        len(jobs),
-        n_jobs,
+    df = run_points(
+        points, specs, model, seed, int(cfg["replicates"]), n_jobs, "horizon_lqg_estimators"
     )
-    rows = [r for part in parallel_map(_estimator_task, jobs, n_jobs, desc="cells") for r in part]
-    df = pd.DataFrame(rows, columns=ABLATION_COLUMNS)
     order = {(p.problem, p.scheme, p.N, p.M, p.n): i for i, p in enumerate(points)}
     pos = [
         order[(pr, s, n, m, t if s in ("mc", "sobol") else 0)]

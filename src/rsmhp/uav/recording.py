@@ -50,6 +50,7 @@ __all__ = [
     "TRUE_C",
     "check_replay",
     "ellipse_polygon",
+    "record_checked_run",
     "record_uav_run",
     "uav_blueprint",
 ]
@@ -210,3 +211,32 @@ def check_replay(summaries: list[dict], table: pd.DataFrame, rtol: float = 1e-9)
                 f"recording: the replay of {m} gives mean error {got!r} m, the study table "
                 f"{want!r} m (allowed: equal to rtol {rtol:g}); rerun the study's rule"
             )
+
+
+def record_checked_run(
+    path: str | os.PathLike,
+    setup: UAVSetup,
+    methods: list[Method],
+    table: pd.DataFrame,
+    *,
+    seed: int,
+    run: int,
+    max_hypotheses: int,
+    note: str,
+    log,
+) -> None:
+    """:func:`record_uav_run` of run ``run``, its replay checked against the study's rows of
+    that run (``table``, :func:`check_replay`), each method's mean error and the logged
+    entities written to ``log`` (a :class:`logging.Logger`)."""
+    rows, summaries = record_uav_run(
+        path, setup, methods, seed=seed, run=run, max_hypotheses=max_hypotheses, note=note
+    )
+    check_replay(summaries, table[table["run"] == run])
+    for s in summaries:
+        log.info(
+            "%s: mean error %.2f m, detections %.0f%%",
+            s["method"],
+            s["mean_error"],
+            100 * s.get("detect_rate", 1.0),
+        )
+    log.info("logged %d entities, %d rows", len(rows), sum(rows.values()))
