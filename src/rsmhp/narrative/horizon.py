@@ -279,7 +279,8 @@ def _setting(cfg: Mapping[str, Any], hs: Sequence[int]) -> str:
         "time**: each method plans once per state, scored as in the decision study, and is "
         "timed on a second plan call (one thread). The tree search estimates no given plan's "
         f"cost: regret and time only. **Closed loop**: {int(cfg['closed_runs'])} paired runs "
-        "per method and H (the same scenarios at every H)."
+        "per method and H (the same scenarios at every H). The rules of HZ-1..HZ-5 are in the "
+        "config, written after pilot runs that gave the same signs (the config says which)."
     )
 
 
