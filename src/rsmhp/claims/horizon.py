@@ -260,9 +260,8 @@ def hz4_rule(N: int, M: int, h_lo: int, h_hi: int) -> Rule:
         KEY,
         0.0,
         claimed="above",
-        basis=f"g = growth of the relative RMSE from H = {h_lo} to {h_hi} of the pruned tree "
-        f"(N = {N}, M = {M}) − that of Monte Carlo with n = {M} (exact J; bootstrap over "
-        "replicates, each cell resampled on its own)",
+        basis=f"g = relative-RMSE growth H = {h_lo} → {h_hi}, pruned tree (N = {N}, M = {M}) "
+        f"− Monte Carlo (n = {M}); exact J, bootstrap over replicates",
     )
 
 
