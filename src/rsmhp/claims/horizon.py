@@ -266,8 +266,8 @@ def hz4_rule(N: int, M: int, h_lo: int, h_hi: int) -> Rule:
 
 
 HZ5_RULE = Rule(
-    basis="max |z| of the uniform Monte-Carlo cells (every a, H and P) against κ_H v_H / P, "
-    "z = (mean − closed form) / (closed form √(2/R))",
+    basis="max |z| of uniform Monte Carlo's mean regret against κ_H v_H / P over every (a, H, "
+    "P), z = (mean − closed form) / (closed form √(2/R))",
     cases=(
         Case(
             "supported",

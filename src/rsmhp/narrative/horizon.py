@@ -14,7 +14,7 @@ import pandas as pd
 from rsmhp.claims.horizon import horizon_claims, lqg_horizon_claims
 from rsmhp.figures.horizon import FIGURES
 from rsmhp.ledger import Claim, Section
-from rsmhp.markdown import ci_cells, fmt, fmt_ci, markdown_table
+from rsmhp.markdown import ci_cells, fmt, markdown_table
 from rsmhp.palette import method_label
 
 __all__ = ["FIGURES", "TABLES", "horizon_section", "horizon_tables"]
@@ -282,22 +282,12 @@ def _setting(cfg: Mapping[str, Any], hs: Sequence[int]) -> str:
     )
 
 
-def _claim_lines(claims: Sequence[Claim]) -> str:
-    """``ID (verdict): key value unit [CI].`` per claim (no CI for a bitwise number)."""
-    out = []
-    for c in claims:
-        k = c.key
-        ci = f" {fmt_ci(k.ci_low, k.ci_high, k.digits, True)}" if k.ci_low is not None else ""
-        signed = k.null is not None
-        out.append(
-            f"{c.id} ({c.verdict}): {k.name} {fmt(k.value, k.digits, signed)} {k.unit}".rstrip()
-            + f"{ci}."
-        )
-    return " ".join(out)
-
-
 def _findings(claims: Sequence[Claim], a: pd.DataFrame, r: pd.DataFrame) -> str:
-    out = [_claim_lines(claims)] if claims else []
+    out = (
+        [f"Claims {', '.join(c.id for c in claims)}: key numbers and verdicts in the ledger."]
+        if claims
+        else []
+    )
     h_hi = max(int(h) for h in a["H"].unique())
     for model, s in a[a["H"] == h_hi].groupby("model", sort=False):
         ranked = s.sort_values("rel_rmse")
@@ -378,8 +368,6 @@ def horizon_section(
             _runs_text(closed_summary) if closed_summary is not None else "",
             "",
             _lqg_text(lqg_table, a_model, float(lqg_cfg["eps"])),
-            "",
-            _claim_lines(lqg_claims),
             "",
             _lqg_sim_text(est_s, reg_s, a_model),
             "",
