@@ -267,18 +267,15 @@ def _runs_text(closed_summary: pd.DataFrame) -> str:
 def _setting(cfg: Mapping[str, Any], hs: Sequence[int]) -> str:
     return (
         f"H ∈ {{{', '.join(str(h) for h in hs)}}} on "
-        f"{', '.join(repr(m) for m in cfg['models'])}, at the belief states of "
+        f"{', '.join(repr(m) for m in cfg['models'])}, belief states of "
         f"{int(cfg['runs'])} NBO runs (the same at every H). **Cost approximation**: each "
-        f"method's estimate of the cost (Σ tr P) of {int(cfg['plans'])} random plans per state "
-        f"against a reference of {int(cfg['n_ref'])} independent hypotheses (random methods "
-        f"drawn {int(cfg['replicates'])} times); relative RMSE noise-corrected (the "
-        "reference's variance subtracted), 95% bootstrap CIs over runs (each with its states). "
-        "**Decisions and "
-        "time**: each method plans once per state, scored as in the decision study, and is "
-        "timed on a second plan call (one thread). The tree search estimates no given plan's "
-        f"cost: regret and time only. **Closed loop**: {int(cfg['closed_runs'])} paired runs "
-        "per method and H (the same scenarios at every H). The rules of HZ-1..HZ-5 are in the "
-        "config, written after pilot runs that gave the same signs (the config says which)."
+        f"method's estimate of Σ tr P for {int(cfg['plans'])} random plans per state against "
+        f"{int(cfg['n_ref'])} independent hypotheses ({int(cfg['replicates'])} draws of a "
+        "random method); RMSE noise-corrected, CIs over runs. **Decisions and time**: one "
+        "plan per state, scored as in the decision study, timed on a second call (one "
+        "thread); the tree search has no cost estimate. **Closed loop**: "
+        f"{int(cfg['closed_runs'])} paired runs per method and H (the same scenarios at every "
+        "H). The HZ rules are in the config, written after pilots that gave the same signs."
     )
 
 
@@ -322,9 +319,8 @@ _FIGURE = [
     "",
     "![Cost approximation by horizon](figures/hz_uav_error.png)",
     "",
-    "*Relative RMSE (log scale, noise-corrected; below the reference's noise drawn at "
-    "0.001%) and bias of each method's cost estimate against the reference, by horizon; "
-    "bars: 95% bootstrap CIs over belief states.*",
+    "*Relative RMSE (log scale, noise-corrected; below the reference's noise: drawn at "
+    "0.001%) and bias of each cost estimate, by horizon; bars: 95% CIs over runs.*",
     "",
     "![Planning time and regret by horizon](figures/hz_uav_time.png)",
     "",
