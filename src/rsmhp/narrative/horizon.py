@@ -217,8 +217,7 @@ def _lqg_sim_text(est: pd.DataFrame, reg: pd.DataFrame, a_model: float) -> str:
             + f" at H = {h_lo}, {h_hi} (closed forms "
             + ", ".join(f"{fmt(float(m1.loc[h, 'closed_form']), 3)}" for h in (h_lo, h_hi))
             + f"; limit {fmt(float(m1.loc[h_hi, 'limit']), 3)}); NBO, antithetic pairs and "
-            "sigma points have zero regret at every H (their samples' mean final-state noise "
-            "is 0)."
+            "sigma points have zero regret at every H."
         )
     if not w.empty:
         bad = w[w["z"].abs() > 3.0]
@@ -247,15 +246,15 @@ def _runs_text(closed_summary: pd.DataFrame) -> str:
         resolved = (g["error_diff_low"] > 0) | (g["error_diff_high"] < 0)
         need = g.loc[~resolved, "runs_to_resolve"]
         rest = (
-            f"; the other {len(need)} would need {int(need.min())} to {int(need.max())} runs "
-            f"(median {int(need.median())})"
+            f", the rest need {int(need.min())} to {int(need.max())} runs (median "
+            f"{int(need.median())})"
             if len(need)
             else ""
         )
         out.append(
-            f"'{model}': {int(g['runs'].min())} paired runs per comparison with NBO, CI "
-            f"half-widths {fmt(float(half.min()), 2)} to {fmt(float(half.max()), 2)} m; "
-            f"{int(resolved.sum())} of {len(g)} CIs exclude 0{rest}"
+            f"'{model}': {int(g['runs'].min())} runs, half-widths {fmt(float(half.min()), 2)} "
+            f"to {fmt(float(half.max()), 2)} m, {int(resolved.sum())} of {len(g)} CIs exclude "
+            f"0{rest}"
         )
     return (
         "Runs needed (closed loop; table hz_uav_closed, (1.96 SD / |mean difference|)²): "
