@@ -218,6 +218,18 @@ def test_claims_follow_their_rules():
             lambda hz: hz["claims"].update(closed_model="paper2"),
             "horizon.uav.claims.closed_model: 'paper2' is not a model of horizon.uav.models",
         ),
+        (
+            lambda hz: hz["recording"].update(model="paper2"),
+            "horizon.uav.recording.model: 'paper2' is not a model of horizon.uav.models",
+        ),
+        (
+            lambda hz: hz["recording"].update(H=5),
+            "horizon.uav.recording.H: 5 is not a horizon of horizon.uav.H",
+        ),
+        (
+            lambda hz: hz["recording"].update(select="best"),
+            "horizon.uav.recording.select",
+        ),
     ],
 )
 def test_bad_horizon_config_is_refused_naming_the_field(edit, expected):

@@ -402,24 +402,31 @@ def test_horizon_lqg_outputs(run_j2, tiny):
     assert (run_j2 / "results/paper/figures/hz_lqg.png").read_bytes()[:4] == b"\x89PNG"
 
 
-def test_horizon_recording_replays_run_of_the_config(run_j2, tiny):
-    """horizon.uav.recording: one member per family at the configured H and run, each with its
-    map and hypotheses (the tree search has none); the replay equals the closed-loop row."""
-    rec = tiny["horizon"]["uav"]["recording"]
+def test_horizon_recording_replays_the_run_its_rule_chooses(run_j2, tiny):
+    """horizon.uav.recording: one member per family at the configured H, in the run chosen by
+    `select` from the closed-loop runs (claims.monte_carlo − NBO), each with its map and
+    hypotheses (the tree search has none); the replay equals the closed-loop rows."""
+    from rsmhp.analysis.frontier import select_run
+
+    hz = tiny["horizon"]["uav"]
+    rec = hz["recording"]
     log = (run_j2 / "results/logs/horizon_recording.log").read_text()
     closed = pd.read_csv(run_j2 / f"results/horizon/uav/{rec['model']}_H{rec['H']}_closed.csv")
+    mc = hz["claims"]["monte_carlo"]
+    run, d = select_run(closed, rec["model"], mc, "nbo", rec["select"])
+    assert f"run {run} ({rec['select']} of {mc} − nbo: d = {d:+.3f} m)" in log
     families = list(dict.fromkeys(closed["family"]))
     path = run_j2 / f"results/recordings/hz_{rec['model']}_H{rec['H']}.rrd"
     entities = set()
     for chunk in RrdReader(path).store().stream():
         entities.add(str(chunk.entity_path))
-    one = closed[closed["run"] == rec["run"]].groupby("family", sort=False)["method"].last()
+    one = closed[closed["run"] == run].groupby("family", sort=False)["method"].last()
     assert list(one.index) == families
     for family, m in one.items():
         assert f"/{m}/map/plan" in entities and f"/{m}/map/uav_path" in entities
         if family != "dpw":
             assert f"/{m}/map/hypotheses" in entities
-        row = closed[(closed["run"] == rec["run"]) & (closed["method"] == m)].iloc[0]
+        row = closed[(closed["run"] == run) & (closed["method"] == m)].iloc[0]
         assert f"{m}: mean error {row['mean_error']:.2f} m" in log
 
 

@@ -408,11 +408,10 @@ def _horizon_problems(config: Mapping[str, Any], names: list, n_steps: int) -> l
                 f"{path}.recording.H: {rec['H']} is not a horizon of {path}.H (allowed: "
                 f"{', '.join(map(str, hs))})"
             )
-        n_closed = hz.get("closed_runs")
-        if isinstance(n_closed, int) and isinstance(rec.get("run"), int) and rec["run"] >= n_closed:
+        if not (claims.get("monte_carlo") or ""):
             problems.append(
-                f"{path}.recording.run: {rec['run']} is not a closed-loop run (allowed: 0 <= "
-                f"run < {path}.closed_runs = {n_closed})"
+                f"{path}.recording.model: {rec['model']!r} needs {path}.claims.monte_carlo "
+                "(the run is chosen from its paired differences with NBO), got ''"
             )
     for key, family in (("tree", PrunedTree), ("monte_carlo", MonteCarlo)):
         name = claims.get(key) or ""

@@ -208,7 +208,7 @@ rule horizon_recording:
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         models=canonical(config["decisions"]["uav"]["models"]),
-        cfg=pick(HZ, "closed_runs", "methods"),
+        cfg=pick(HZ, "closed_runs", "methods", "claims"),
         recording=canonical(HZ_REC),
         seed=config["seed"],
         code=code_digest("workflow/scripts/horizon_recording.py"),

@@ -205,15 +205,21 @@ def budget_check(summary: pd.DataFrame, members: Sequence[str], budget_ms: float
 RUN_SELECTIONS = ("nearest_mean", "nearest_median", "largest_gain", "largest_loss")
 
 
-def select_run(runs: pd.DataFrame, model: str, a: str, b: str, rule: str) -> tuple[int, float]:
+def select_run(
+    runs: pd.DataFrame,
+    model: str,
+    a: str,
+    b: str,
+    rule: str,
+    path: str = "decisions.recording.select",
+) -> tuple[int, float]:
     """The run of ``model`` a recording shows and its d_r = mean_error(``a``) − that of
     ``b`` (m): ``rule`` "nearest_mean" / "nearest_median": d_r nearest the mean / median of d
     over the runs; "largest_gain" / "largest_loss": the most negative / positive d_r. Ties:
-    the lowest run index (deterministic; no timing column is read)."""
+    the lowest run index (deterministic; no timing column is read). ``path`` names the config
+    key in the message for an unknown rule."""
     if rule not in RUN_SELECTIONS:
-        raise ValueError(
-            f"decisions.recording.select: {rule!r} (allowed: {', '.join(RUN_SELECTIONS)})"
-        )
+        raise ValueError(f"{path}: {rule!r} (allowed: {', '.join(RUN_SELECTIONS)})")
     g = runs[runs["model"] == model]
     wide = g.pivot(index="run", columns="method", values="mean_error")
     for m in (a, b):
