@@ -29,10 +29,10 @@ Models
                     dpw (compiled tree search with double progressive widening),
                     simulation, recording
 Stages of the pipeline (one module per model and stage)
-  experiments       lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon:
-                    config -> tidy tables
-  analysis          lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon:
-                    tables -> statistics
+  experiments       lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon,
+                    horizon_lqg: config -> tidy tables
+  analysis          lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon,
+                    horizon_lqg: tables -> statistics
   figures           lqg, estimators, uav, decisions, frontier, horizon: seaborn figures (PNG
                     + PDF)
   recording         rerun recordings of sampled trajectory trees
