@@ -70,6 +70,31 @@ if _memory:
     sys.exit("invalid configuration (nothing was run):\n  - " + "\n  - ".join(_memory))
 
 
+# On a SLURM cluster: every job must fit on a node of its partition (threads after
+# set-threads and max-threads, mem_mb after set-resources), checked against `sinfo` before
+# anything is submitted; SLURM would otherwise keep it pending forever, silently.
+onstart:
+    if (
+        workflow.executor_plugin is not None
+        and workflow.executor_plugin.name == "slurm"
+    ):
+        from rsmhp.cluster import ClusterFitError, JobAsk, check_jobs
+
+        try:
+            check_jobs(
+                JobAsk(
+                    job.rule.name,
+                    int(job.threads),
+                    job.resources.get("mem_mb"),
+                    job.resources.get("slurm_partition") or None,
+                )
+                for job in workflow.dag.needrun_jobs()
+                if not job.is_local
+            )
+        except ClusterFitError as exc:
+            sys.exit(str(exc))
+
+
 rule all:
     """Default target: the full replication and its report."""
     default_target: True

@@ -1,0 +1,172 @@
+"""The workflow on a real single-node SLURM cluster (scripts/slurm-local.sh), through the
+profile workflow/profiles/slurm, with the commands of the README's "Run on a cluster".
+
+Marker ``slurm``: run on the project's machines (root on Debian; CI brings the cluster up from
+the distribution's packages), skipped with the reason elsewhere. Oracles: SLURM's own record
+of every finished job (/var/log/slurm/jobcomp.tsv, written by slurmctld's jobcomp/script hook,
+and `scontrol`), the local -j2 run of the same config (byte-identical tables apart from
+timing columns) and the profile's and rules' declared threads and memory.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pandas as pd
+import pytest
+import yaml
+
+from rsmhp.experiments.uav import NONDETERMINISTIC_COLUMNS
+from tests.test_workflow import CSVS, ROOT, TINY
+
+pytestmark = pytest.mark.slurm
+
+SCRIPT = ROOT / "scripts" / "slurm-local.sh"
+PROFILE = ROOT / "workflow" / "profiles" / "slurm"
+RECORDS = Path("/var/log/slurm/jobcomp.tsv")
+#: the README's command, with the node's CPU count as max-threads and quick status checks
+RUN = [
+    sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--configfile", str(TINY),
+    "--profile", str(PROFILE), "--max-threads", str(os.cpu_count() or 1),
+    "--seconds-between-status-checks", "2", "--slurm-init-seconds-before-status-checks", "2",
+]  # fmt: skip
+
+
+def _why_not() -> str | None:
+    if os.name != "posix" or os.geteuid() != 0:
+        return "needs root to bring up a local SLURM cluster (scripts/slurm-local.sh up)"
+    if not Path("/etc/debian_version").exists() or shutil.which("apt-get") is None:
+        return "needs a Debian machine with apt-get (SLURM from the distribution's packages)"
+    if os.environ.get("RSMHP_SLURM_TEST", "1") == "0":
+        return "RSMHP_SLURM_TEST=0"
+    return None
+
+
+@pytest.fixture(scope="module")
+def cluster():
+    """The local cluster, up for this module and down after it."""
+    reason = _why_not()
+    if reason:
+        pytest.skip(reason)
+    res = subprocess.run(["bash", str(SCRIPT), "up"], capture_output=True, text=True, check=False)
+    if res.returncode != 0 and "not available from the configured apt sources" in res.stderr:
+        pytest.skip(res.stderr.strip())
+    assert res.returncode == 0, res.stdout[-2000:] + res.stderr[-2000:]
+    yield
+    subprocess.run(["bash", str(SCRIPT), "down"], capture_output=True, text=True, check=False)
+
+
+def _records(workdir: Path) -> pd.DataFrame:
+    """SLURM's records of the jobs whose log lies under ``workdir``, with their rule."""
+    df = pd.read_csv(RECORDS, sep="\t", dtype=str, keep_default_na=False)
+    df = df[df["StdOut"].str.startswith(str(workdir))].copy()
+    df["rule"] = df["Comment"].str.extract(r"^rule_(.+?)(?:_wildcards_.*)?$")[0]
+    return df
+
+
+def _tres(tres: str) -> dict[str, str]:
+    return dict(kv.split("=", 1) for kv in tres.split(",") if "=" in kv)
+
+
+def _planned(out: str) -> dict[str, int]:
+    """Snakemake's job table ("Job stats"): rule -> jobs."""
+    table = out.split("Job stats:", 1)[1].split("total", 1)[0]
+    return {
+        m.group(1): int(m.group(2)) for m in re.finditer(r"^(\w+)\s+(\d+)\s*$", table, flags=re.M)
+    }
+
+
+def test_tiny_workflow_runs_through_slurm_like_locally(cluster, run_j2, tmp_path):
+    res = subprocess.run(RUN, cwd=tmp_path, capture_output=True, text=True, check=False)
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-4000:]
+    rec = _records(tmp_path)
+    # every job Snakemake planned went through the scheduler (local rules: the targets)
+    planned = _planned(out)
+    local = set(re.findall(r"^localrule (\w+):", out, flags=re.M))
+    by_rule = rec.groupby("rule").size().to_dict()
+    assert {r: n for r, n in planned.items() if r not in local} == by_rule
+    assert (rec["JobState"] == "COMPLETED").all() and (rec["Partition"] != "").all()
+    assert local <= {"all", "lqg", "estimators", "uav", "decisions", "frontier", "horizon"}
+    # the results are the local run's, byte for byte apart from timing columns
+    for rel in CSVS:
+        assert (tmp_path / rel).read_bytes() == (run_j2 / rel).read_bytes(), rel
+    a = pd.read_csv(tmp_path / "results/uav/runs.csv").drop(columns=list(NONDETERMINISTIC_COLUMNS))
+    b = pd.read_csv(run_j2 / "results/uav/runs.csv").drop(columns=list(NONDETERMINISTIC_COLUMNS))
+    pd.testing.assert_frame_equal(a, b, check_exact=True)
+    assert (tmp_path / "results/paper/claims.json").exists()
+    # threads and memory that reached each job: the rule's, after the profile's set-threads
+    # (capped by max-threads = the node's CPUs) and set-resources / default-resources
+    profile = yaml.safe_load((PROFILE / "config.yaml").read_text())
+    cpus = os.cpu_count() or 1
+    for _, r in rec.iterrows():
+        tres = _tres(r["TRES"])
+        declared = profile["set-threads"].get(r["rule"])
+        if declared is not None:
+            assert int(tres["cpu"]) == min(declared, cpus), r["rule"]
+        mem = profile["set-resources"].get(r["rule"], {}).get("mem_mb")
+        if mem is not None:
+            assert tres["mem"] == f"{mem}M", r["rule"]
+    assert _tres(rec[rec["rule"] == "lqg_convergence"]["TRES"].iloc[0])["cpu"] == str(min(8, cpus))
+    assert _tres(rec[rec["rule"] == "estimators_ablation"]["TRES"].iloc[0])["mem"] == "8000M"
+    # a rule's own threads (horizon_lqg_estimators: 2) reach SLURM as CPUs per task
+    hz = rec[rec["rule"] == "horizon_lqg_estimators"]["TRES"]
+    assert _tres(hz.iloc[0])["cpu"] == str(min(2, cpus))
+
+
+def test_a_cancelled_job_is_retried_and_the_run_completes(cluster, tmp_path):
+    """scancel of a running job: the profile's `retries: 1` resubmits it, the run ends well."""
+    proc = subprocess.Popen(
+        [*RUN, "lqg"], cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True
+    )
+    cancelled = None
+    deadline = time.time() + 300
+    while cancelled is None and time.time() < deadline and proc.poll() is None:
+        q = subprocess.run(
+            ["squeue", "-h", "-t", "RUNNING", "-o", "%i|%k|%o"],
+            capture_output=True, text=True, check=False,
+        )  # fmt: skip
+        for line in q.stdout.splitlines():
+            jid, comment, _ = line.split("|", 2)
+            if comment.startswith("rule_lqg_convergence"):
+                subprocess.run(["scancel", jid], check=True)
+                cancelled = jid
+                break
+        time.sleep(0.5)
+    out, _ = proc.communicate(timeout=600)
+    assert cancelled is not None, "no lqg_convergence job was seen running\n" + out[-3000:]
+    assert proc.returncode == 0, out[-4000:]
+    rec = _records(tmp_path)
+    conv = rec[rec["rule"] == "lqg_convergence"]
+    assert list(conv["JobState"]) == ["CANCELLED", "COMPLETED"], conv
+    assert conv["JobId"].iloc[0] == cancelled
+    assert (tmp_path / "results/lqg/convergence.csv").exists()
+
+
+def test_a_job_larger_than_any_node_is_refused_before_submission(cluster, tmp_path):
+    """Without max-threads the profile's 8-thread rules exceed a smaller node: the run is
+    refused up front, naming the rule, its ask and the partition's offer; nothing is queued."""
+    cpus = os.cpu_count() or 1
+    if cpus >= 8:
+        pytest.skip(f"the node has {cpus} CPUs: every rule of the profile fits")
+    before = len(pd.read_csv(RECORDS, sep="\t", dtype=str)) if RECORDS.exists() else 0
+    at = RUN.index("--max-threads")
+    cmd = RUN[:at] + RUN[at + 2 :]
+    res = subprocess.run([*cmd, "lqg"], cwd=tmp_path, capture_output=True, text=True, check=False)
+    out = res.stdout + res.stderr
+    assert res.returncode != 0
+    assert (
+        f"rule lqg_convergence: asks for 8 CPUs (threads), partition 'debug' offers at most "
+        f"{cpus} per node" in out
+    )
+    assert "nothing was submitted" in out
+    after = len(pd.read_csv(RECORDS, sep="\t", dtype=str)) if RECORDS.exists() else 0
+    assert after == before
+    q = subprocess.run(["squeue", "-h"], capture_output=True, text=True, check=True)
+    assert q.stdout.strip() == ""
