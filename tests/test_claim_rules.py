@@ -15,6 +15,7 @@ import rsmhp.claims
 from rsmhp.claims import decisions_lqg as dl
 from rsmhp.claims import decisions_uav as du
 from rsmhp.claims import estimators as est
+from rsmhp.claims import horizon as hz
 from rsmhp.claims import lqg, uav
 from rsmhp.claims import paper as pp
 from rsmhp.ledger import Claim, KeyNumber
@@ -58,6 +59,14 @@ def _counts(**kw):
 
 #: rule name -> (rule, [(facts, expected verdict), ...])
 EXAMPLES: dict[str, tuple[Rule, list[tuple[dict, str]]]] = {
+    "horizon.HZ5_RULE": (
+        hz.HZ5_RULE,
+        [
+            ({"max |z|": 2.0, "z limit": 3.24}, S),
+            ({"max |z|": 3.24, "z limit": 3.24}, S),
+            ({"max |z|": 3.25, "z limit": 3.24}, NS),
+        ],
+    ),
     "lqg.nbo_error_rule": (
         lqg.nbo_error_rule(3.46, 91),
         [({"max |z|": 2.69}, S), ({"max |z|": 3.46}, S), ({"max |z|": 3.47}, NS)],

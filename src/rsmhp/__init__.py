@@ -58,6 +58,7 @@ Workflow support
   parallel          joblib fan-out that honours a thread budget without oversubscribing BLAS
   pipeline          logging of rule scripts
   code_digest       content digest of the package code each rule imports (reruns never stale)
+  cluster           SLURM pre-flight: every job fits a node of its partition (sinfo)
   numba_cache       drops numba's cache of a module when a module it inlines changed
 """
 
