@@ -104,7 +104,15 @@ class PlannerParams:
 class PlanResult:
     """Optimised controls (H, 2), their cost, the warm start's cost, optimiser counters, the
     planned UAV states (H, 4) and the hypotheses the cost averaged over (``None`` for a
-    planner without hypotheses); ``diagnostics`` holds planner-specific numbers."""
+    planner without hypotheses); ``diagnostics`` holds planner-specific numbers.
+
+    ``work`` is the plan's machine-independent compute, in *model steps*: one model step is
+    one step of one covariance recursion (a 4x4 predict and measurement update). A
+    sampled-cost planner spends :math:`T H` of them per cost evaluation and :math:`2 T H` per
+    evaluation with its gradient (the forward pass and the adjoint pass), for T hypotheses
+    and horizon H; a tree search one per call of its generative model (tree expansions and
+    rollout steps). ``converged`` says whether the optimiser stopped on a tolerance (projected
+    gradient or relative decrease) rather than on a budget (``None``: no optimiser)."""
 
     controls: np.ndarray
     cost: float
@@ -114,6 +122,8 @@ class PlanResult:
     uav_path: np.ndarray  # (H, 4) planned UAV states
     hypotheses: Any = None  # rsmhp.uav.methods.Hypotheses
     diagnostics: dict[str, float] = field(default_factory=dict)
+    work: int = 0  # model steps spent (see above)
+    converged: bool | None = None
 
 
 @dataclass(frozen=True)
@@ -217,6 +227,11 @@ class PlanningProblem:
         """Planned UAV states (H, 4) of one normalised sequence ``x`` (2H,)."""
         return fused.path(x, self._frozen)
 
+    def work(self, evaluations: int) -> int:
+        """Model steps of ``evaluations`` evaluations with gradient: :math:`2 T H` each (the
+        forward covariance recursion of T hypotheses over H steps, and its adjoint)."""
+        return 2 * int(evaluations) * self.target_xy.shape[0] * self.params.horizon
+
     def value_and_grad(self, x: np.ndarray) -> tuple[float, np.ndarray]:
         """``(J(x), grad J(x))`` for one normalised sequence ``x`` (2H,)."""
         x = np.asarray(x, dtype=float)
@@ -296,6 +311,9 @@ def plan(problem: PlanningProblem, warm_start: np.ndarray, *, check: bool = True
         nit=int(res.nit),
         n_kernel_calls=problem.n_kernel_calls,
         uav_path=problem.path(x_best),
+        work=problem.work(problem.n_kernel_calls),  # the cache spares repeats
+        # scipy's status 0: converged (projected gradient or relative decrease); 1: a budget
+        converged=bool(res.status == 0),
     )
 
 
@@ -329,8 +347,14 @@ class BoxQN:
             n_kernel_calls=problem.n_kernel_calls,
             uav_path=problem.path(x),
             diagnostics={"status": float(status)},
+            work=problem.work(nfev),  # the start's evaluation included
+            converged=status in CONVERGED,
         )
 
+
+#: the :data:`rsmhp.boxqn.STATUS` codes of a converged optimisation (a tolerance, not a budget,
+#: stopped it)
+CONVERGED = (0, 1)
 
 #: the optimiser of each ``PlannerParams.optimiser`` name
 OPTIMISERS: dict[str, Optimiser] = {"boxqn": BoxQN(), "scipy": LBFGSB()}

@@ -41,7 +41,11 @@ against the numpy kinematics and sensor and filterpy's Kalman filter); a method 
 Metric of the run: ``mean_error`` :math:`= \frac1K \sum_k e_k` (paper's average target location
 error), ``rmse`` :math:`= (\frac1K\sum_k e_k^2)^{1/2}`, ``mean_trace`` = mean of
 :math:`\mathrm{tr}\,\hat P_k`. ``plan_seconds`` is planner wall time (the only
-non-deterministic output).
+non-deterministic output). ``work_per_step`` is the mean machine-independent compute per
+planning step in model steps (:attr:`rsmhp.uav.planner.PlanResult.work`: covariance-recursion
+steps, a gradient evaluation counting its forward and adjoint pass; generative-model calls of
+a tree search), ``converged_rate`` the fraction of plans whose optimiser stopped on a
+tolerance rather than on its iteration or evaluation budget (NaN for a planner without one).
 """
 
 from __future__ import annotations
@@ -257,6 +261,8 @@ def _simulate_run(setup, method, seed, run, observer):
     warm = np.zeros((H, 2))
     vals = np.empty((K, len(STEP_VALUES)))  # one row of floats per step, dicts built at the end
     counts = np.empty((K, 2), dtype=np.int64)  # nit, kernel calls
+    work = np.empty(K, dtype=np.int64)  # model steps (PlanResult.work)
+    converged = np.full(K, np.nan)  # 1.0 / 0.0 per plan; NaN: no optimiser
     seen_k = np.ones(K, dtype=bool)
     plan_seconds = 0.0
     planner = method.planner(setup)
@@ -277,6 +283,9 @@ def _simulate_run(setup, method, seed, run, observer):
             res.cost, res.cost_warm,
         )  # fmt: skip
         counts[k - 1] = (res.nit, res.n_kernel_calls)
+        work[k - 1] = res.work
+        if res.converged is not None:
+            converged[k - 1] = float(res.converged)
         if observer is not None:
             hyp = res.hypotheses.states if res.hypotheses is not None else np.zeros((0, H, 4))
             observer(
@@ -305,6 +314,8 @@ def _simulate_run(setup, method, seed, run, observer):
         "mean_trace": float(np.mean(vals[:, 1])),
         "mean_nit": float(np.mean(counts[:, 0])),
         "plan_seconds": plan_seconds,
+        "work_per_step": float(np.mean(work)),
+        "converged_rate": float(np.mean(converged)),
     }
     if limited:
         summary["detect_rate"] = int(seen_k.sum()) / K
