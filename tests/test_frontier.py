@@ -12,12 +12,14 @@ import copy
 from pathlib import Path
 
 import numpy as np
+import pandas as pd
 import pytest
 import yaml
 
 from rsmhp.contracts import check_table
 from rsmhp.experiments.decisions_uav import belief_states, merge_variant, score_state
 from rsmhp.experiments.frontier import frontier_contracts, run_frontier_model
+from rsmhp.seeding import job_rng
 from rsmhp.uav import methods
 from rsmhp.uav.simulation import UAVSetup, simulate_run
 
@@ -125,7 +127,7 @@ def test_summary_pairs_with_nbo():
     from rsmhp.analysis.frontier import FRONTIER_SUMMARY_COLUMNS, summarize_frontier
 
     runs, regret, _ = _synthetic()
-    raw = summarize_frontier(runs, regret, seed=3, n_boot=400)
+    raw = summarize_frontier(runs, regret)
     assert list(raw.columns) == FRONTIER_SUMMARY_COLUMNS
     s = raw.set_index("method")
     assert list(s.index) == ["nbo", "rsmhp_nt16", "dpw_s30"]
@@ -146,7 +148,7 @@ def test_summary_pairs_with_nbo():
     assert s.loc["dpw_s30", "lost_rate"] == pytest.approx(1 / 6)
     assert s.loc["dpw_s30", "plan_ms"] == pytest.approx(np.median(1.0 * (1 + 0.01 * np.arange(6))))
     assert s.loc["dpw_s30", "regret_pct"] == pytest.approx(100 * (0.025 + 0.002))
-    again = summarize_frontier(runs, regret, seed=3, n_boot=400).set_index("method")
+    again = summarize_frontier(runs, regret).set_index("method")
     assert again.equals(s)  # seeded per (model, method, statistic)
 
 
@@ -155,12 +157,12 @@ def test_frontier_figure_draws_one_line_per_family():
     from rsmhp.figures.frontier import frontier_figure
 
     runs, regret, _ = _synthetic()
-    fig = frontier_figure(summarize_frontier(runs, regret, seed=3, n_boot=200))
+    fig = frontier_figure(summarize_frontier(runs, regret))
     labels = [t.get_text() for t in fig.axes[0].get_legend().get_texts()]
     assert labels == ["NBO", "RS-MHP", "tree search"]
     assert fig.axes[0].get_xscale() == "log"
     with pytest.raises(ValueError, match="empty"):
-        frontier_figure(summarize_frontier(runs.iloc[:0], regret.iloc[:0], 3, 200))
+        frontier_figure(summarize_frontier(runs.iloc[:0], regret.iloc[:0]))
 
 
 def test_bad_frontier_config_is_refused_naming_the_fields():
@@ -182,3 +184,45 @@ def test_bad_frontier_config_is_refused_naming_the_fields():
     ok = copy.deepcopy(CONFIG)
     ok["decisions"]["frontier"]["models"] = []  # no model: the study does not run
     check_config(ok)
+
+
+def test_interleaved_timing_rotates_the_order_and_times_the_closed_loop_plan():
+    """Every method takes every slot equally often (repeats x states a multiple of the
+    methods), the contract holds, each call's work is the closed loop's plan's work at that
+    belief (same stream key), and the summary's median and per-pass range are the table's."""
+    from rsmhp.analysis.frontier import timing_summary
+    from rsmhp.experiments.frontier import time_planners, timing_contract
+    from rsmhp.uav.planner import Belief
+
+    names = list(methods.from_config(FRONTIER["methods"]))
+    cfg = {**FRONTIER, "timing": {"runs": 1, "steps": [0, 2, 3], "repeats": len(names)}}
+    t = time_planners(_uav(), MODELS, cfg, "footprint150", 5)
+    check_table(t, "timing", timing_contract(cfg, "footprint150"))
+    assert (t["ms"] > 0).all()
+    slots = t.groupby(["method", "slot"]).size().unstack()
+    assert slots.shape == (len(names), len(names)) and (slots == 3).all().all()
+    # the plan is the same in every repeat (the stream is the step's), so is its work
+    assert (t.groupby(["method", "run", "step"])["work"].nunique() == 1).all()
+    setup = UAVSetup.from_config(merge_variant(_uav(), MODELS[1]))
+    st = belief_states(setup, "footprint150", 5, [0], [2])[0]
+    m = methods.from_name("rsmhp_nt16")
+    rng = job_rng(5, "uav_plan", run=0, step=3, **m.job_key())
+    res = m.planner(setup).plan(Belief(st.uav, st.x_hat, st.P_hat), st.warm, rng)
+    got = t[(t["method"] == "rsmhp_nt16") & (t["step"] == 2)]["work"].iloc[0]
+    assert got == res.work == 2 * 16 * 3 * (res.n_kernel_calls)
+    s = timing_summary(t)
+    one = t[t["method"] == "nbo"]
+    assert s.loc[("footprint150", "nbo"), "plan_ms"] == np.median(one["ms"])
+    per_pass = one.groupby("repeat")["ms"].median()
+    assert s.loc[("footprint150", "nbo"), "plan_lo_ms"] == per_pass.min()
+    assert s.loc[("footprint150", "nbo"), "plan_hi_ms"] == per_pass.max()
+
+
+def test_frontier_summary_refuses_a_method_without_timing(footprint):
+    from rsmhp.analysis.frontier import summarize_frontier
+    from rsmhp.experiments.frontier import TIMING_COLUMNS
+
+    runs, regret = footprint
+    timing = pd.DataFrame([["footprint150", "nbo", 0, 0, 0, 0, 1.0, 10]], columns=TIMING_COLUMNS)
+    with pytest.raises(ValueError, match="no interleaved timing of 'rsmhp_nt16'"):
+        summarize_frontier(runs, regret, timing)

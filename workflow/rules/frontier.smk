@@ -51,12 +51,42 @@ rule decisions_frontier:
         "../scripts/decisions_frontier.py"
 
 
+rule decisions_frontier_timing:
+    """Equal-compute study, one model variant: interleaved wall-clock timing of every method's plan call (holds the cores)."""
+    output:
+        "results/decisions/frontier/timing/{model}.csv",
+    log:
+        "results/logs/decisions_frontier_timing/{model}.log",
+    benchmark:
+        "results/benchmarks/decisions_frontier_timing/{model}.tsv"
+    priority: PRIORITY["decisions_frontier"]
+    conda:
+        ENV
+    # the job plans on one thread but holds two: on the 2-core reference machine nothing runs
+    # beside it while it times (snakemake caps threads at --cores)
+    threads: 2
+    resources:
+        mem_mb=2000,
+        runtime=30,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(config["decisions"]["uav"]["models"]),
+        cfg=pick(FRONTIER, "methods", "timing"),
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/decisions_frontier_timing.py"),
+    script:
+        "../scripts/decisions_frontier_timing.py"
+
+
 rule decisions_frontier_summary:
     """Equal-compute study: per model and method, compute and quality with bootstrap CIs."""
     input:
         runs=expand("results/decisions/frontier/{model}.csv", model=FRONTIER_MODELS),
         regret=expand(
             "results/decisions/frontier/{model}_regret.csv", model=FRONTIER_MODELS
+        ),
+        timing=expand(
+            "results/decisions/frontier/timing/{model}.csv", model=FRONTIER_MODELS
         ),
     output:
         summary="results/decisions/frontier_summary.csv",

@@ -8,23 +8,29 @@ import pandas as pd
 
 from rsmhp.analysis.frontier import summarize_frontier
 from rsmhp.contracts import read_checked
-from rsmhp.experiments.frontier import frontier_contracts
+from rsmhp.experiments.frontier import frontier_contracts, timing_contract
 from rsmhp.io import write_csv, write_text
 from rsmhp.narrative.frontier import frontier_section, frontier_tables
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake) as log:
     p = snakemake.params
-    runs, regret = [], []
-    for model, r_path, g_path in zip(
-        p.cfg["models"], snakemake.input.runs, snakemake.input.regret, strict=True
+    runs, regret, timing = [], [], []
+    for model, r_path, g_path, t_path in zip(
+        p.cfg["models"],
+        snakemake.input.runs,
+        snakemake.input.regret,
+        snakemake.input.timing,
+        strict=True,
     ):
         c_runs, c_regret = frontier_contracts(p.cfg, model)
         runs.append(read_checked(r_path, c_runs))
         regret.append(read_checked(g_path, c_regret))
+        timing.append(read_checked(t_path, timing_contract(p.cfg, model)))
     runs = pd.concat(runs, ignore_index=True)
     regret = pd.concat(regret, ignore_index=True)
-    summary = summarize_frontier(runs, regret, p.seed, p.cfg["bootstrap"])
+    timing = pd.concat(timing, ignore_index=True)
+    summary = summarize_frontier(runs, regret, timing)
     tables = frontier_tables(summary, p.cfg)
     section = frontier_section(runs, regret, summary, tables, p.cfg, p.seed, p.horizon)
     write_csv(summary, snakemake.output.summary)

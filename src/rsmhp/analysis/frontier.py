@@ -2,19 +2,29 @@ r"""Equal-compute study: statistics of the planner frontier (tables -> numbers, 
 
 Per (model, method), from the rule ``decisions_frontier``'s tables:
 
-* compute: ``plan_ms``, the median over runs of the planning milliseconds per step;
+* compute, in two units: wall clock, ``plan_ms``, the median planning milliseconds per step
+  of the interleaved timing (rule ``decisions_frontier_timing``: every method at the same
+  belief states, round robin, several passes), with ``plan_lo_ms`` / ``plan_hi_ms`` the
+  smallest and largest per-pass median (the spread from one pass to the next) and
+  ``loop_ms`` the median over closed-loop runs of their planning time per step (measured
+  beside whatever else ran); machine-independent, ``work_per_step``, the median over runs
+  of the model steps per planning step (:attr:`rsmhp.uav.planner.PlanResult.work`), with
+  the optimiser's mean iterations ``mean_nit`` and the share of plans that converged
+  ``converged_rate`` (NaN without an optimiser). Without a timing table ``plan_ms`` is the
+  closed loop's;
 * closed loop: mean location error over runs and the paired difference method − NBO of the
-  per-run mean error (m; negative: the method tracks better), with a percentile-bootstrap
-  CI over runs; the share of runs that lost the track;
+  per-run mean error (m; negative: the method tracks better), with a CI over runs; the
+  share of runs that lost the track;
 * open loop: mean relative regret over belief states (%) and the paired difference method −
-  NBO at the same states (percentage points), each with a bootstrap CI over states.
+  NBO at the same states (percentage points), each with a CI over runs.
 
-Bootstrap streams are keyed on (model, method, statistic), so a row never depends on the
-other rows.
+Every CI is a 95% cluster-t interval over runs (:func:`cluster_mean_ci`: the belief states of
+one run share its scenario and are not independent; with 10 to 50 runs a percentile
+bootstrap is too narrow, see :mod:`rsmhp.stats`).
 
 Between two members a, b of the study (the equal-compute comparisons of claims FR-1..3):
 :func:`paired_difference`, the mean of d = x(a) − x(b) paired per run (closed loop) or per
-belief state (open loop) with its bootstrap CI; :func:`budget_check`, each budget member's
+belief state (open loop) with its cluster-t CI; :func:`budget_check`, each budget member's
 measured time against the budget and the largest member of its family that fits it;
 :func:`select_run`, the run a recording shows, by a rule on the paired differences.
 """
@@ -28,7 +38,7 @@ import numpy as np
 import pandas as pd
 
 from rsmhp.seeding import job_rng
-from rsmhp.stats import bootstrap_ci
+from rsmhp.stats import ClusterInterval, bootstrap_ci, cluster_t_ci
 from rsmhp.uav import methods
 
 __all__ = [
@@ -37,9 +47,11 @@ __all__ = [
     "RUN_SELECTIONS",
     "Paired",
     "budget_check",
+    "cluster_mean_ci",
     "paired_difference",
     "select_run",
     "summarize_frontier",
+    "timing_summary",
 ]
 
 FRONTIER_SUMMARY_COLUMNS = [
@@ -47,6 +59,12 @@ FRONTIER_SUMMARY_COLUMNS = [
     "method",
     "family",
     "plan_ms",
+    "plan_lo_ms",
+    "plan_hi_ms",
+    "loop_ms",
+    "work_per_step",
+    "mean_nit",
+    "converged_rate",
     "runs",
     "mean_error",
     "error_diff",
@@ -64,20 +82,68 @@ FRONTIER_SUMMARY_COLUMNS = [
 
 
 def _ci(x: np.ndarray, seed: int, n_boot: int, **key: Any) -> tuple[float, float]:
-    """95% percentile-bootstrap CI of the mean of ``x`` (NaNs for fewer than 2 values)."""
+    """95% percentile-bootstrap CI of the mean of ``x`` (NaNs for fewer than 2 values): the
+    interval of the exploratory tables up to 76a0c01, kept beside the cluster-t one."""
     x = np.asarray(x, dtype=float)
     if x.size < 2:
         return float("nan"), float("nan")
     return bootstrap_ci(x, job_rng(seed, "frontier_bootstrap", **key), n_boot, 0.95)
 
 
+def cluster_mean_ci(x: np.ndarray, clusters: np.ndarray) -> ClusterInterval | None:
+    r"""The mean of ``x`` with its 95% cluster-t interval over the labels ``clusters`` (the
+    runs: belief states of one run share its scenario, so they are not independent):
+    :func:`rsmhp.stats.cluster_t_ci` of :math:`\bar x` over the G runs (leave-one-run-out
+    jackknife, t with G − 1 degrees of freedom; with one value per run it is Student's t
+    interval). ``None`` for fewer than 2 runs."""
+    x = np.asarray(x, dtype=float)
+    labels, inverse = np.unique(np.asarray(clusters), return_inverse=True)
+    if labels.size < 2:
+        return None
+    sums = np.bincount(inverse, weights=x, minlength=labels.size)
+    counts = np.bincount(inverse, minlength=labels.size).astype(float)
+
+    def stat(idx: np.ndarray) -> float:
+        return float(sums[idx].sum() / counts[idx].sum())
+
+    return cluster_t_ci(stat, int(labels.size))
+
+
+def _cluster_ci(x: np.ndarray, clusters: np.ndarray) -> tuple[float, float]:
+    ci = cluster_mean_ci(x, clusters)
+    return (float("nan"), float("nan")) if ci is None else (ci.low, ci.high)
+
+
+def _stat(m: pd.DataFrame, col: str, how: str) -> float:
+    """``m[col].median()`` or ``.mean()``; NaN for a table without the column (older runs)."""
+    return float(getattr(m[col], how)()) if col in m else float("nan")
+
+
+def timing_summary(timing: pd.DataFrame) -> pd.DataFrame:
+    """Per (model, method) of an interleaved timing table
+    (:data:`rsmhp.experiments.frontier.TIMING_COLUMNS`): ``plan_ms`` the median over every
+    call, ``plan_lo_ms`` / ``plan_hi_ms`` the smallest and largest median of one pass."""
+    if timing.empty:
+        raise ValueError("timing: no rows (the interleaved timing table is empty)")
+    per_pass = timing.groupby(["model", "method", "repeat"], sort=False)["ms"].median()
+    spread = per_pass.groupby(level=["model", "method"], sort=False).agg(["min", "max"])
+    med = timing.groupby(["model", "method"], sort=False)["ms"].median()
+    return pd.DataFrame({"plan_ms": med, "plan_lo_ms": spread["min"], "plan_hi_ms": spread["max"]})
+
+
 def summarize_frontier(
-    runs: pd.DataFrame, regret: pd.DataFrame, seed: int, n_boot: int
+    runs: pd.DataFrame,
+    regret: pd.DataFrame,
+    timing: pd.DataFrame | None = None,
 ) -> pd.DataFrame:
     """One row per (model, method) of ``runs`` (see the module docstring), in the tables'
     order. ``runs``: rows of :data:`rsmhp.experiments.frontier.FRONTIER_RUN_COLUMNS`;
-    ``regret``: rows of :data:`rsmhp.experiments.decisions_uav.REGRET_COLUMNS`."""
+    ``regret``: rows of :data:`rsmhp.experiments.decisions_uav.REGRET_COLUMNS`; ``timing``:
+    rows of :data:`rsmhp.experiments.frontier.TIMING_COLUMNS` (``None``: the closed loop's
+    times). A (model, method) of ``runs`` missing from ``timing`` is refused, naming it."""
     base = methods.baseline()().name
+    times = timing_summary(timing) if timing is not None else None
+    nan = float("nan")
     out = []
     for model, g in runs.groupby("model", sort=False):
         err = g.pivot(index="run", columns="method", values="mean_error")
@@ -85,14 +151,28 @@ def summarize_frontier(
             index=["run", "step"], columns="method", values="regret_rel"
         )
         for method, m in g.groupby("method", sort=False):
-            key = {"model": model, "method": method}
             d_err = (err[method] - err[base]).to_numpy(float)
-            e_lo, e_hi = _ci(d_err, seed, n_boot, **key, statistic="error_diff")
+            e_lo, e_hi = _cluster_ci(d_err, err.index.to_numpy())
+            loop_ms = float(m["plan_ms"].median())
+            if times is None:
+                clock = {"plan_ms": loop_ms, "plan_lo_ms": nan, "plan_hi_ms": nan}
+            elif (model, method) in times.index:
+                clock = {k: float(v) for k, v in times.loc[(model, method)].items()}
+            else:
+                raise ValueError(
+                    f"timing: no interleaved timing of {method!r} on {model!r} "
+                    f"(timed: {sorted(set(map(str, times.index)))})"
+                )
+            conv = m["converged_rate"] if "converged_rate" in m else pd.Series([nan])
             row = {
                 "model": model,
                 "method": method,
                 "family": m["family"].iloc[0],
-                "plan_ms": float(m["plan_ms"].median()),
+                **clock,
+                "loop_ms": loop_ms,
+                "work_per_step": _stat(m, "work_per_step", "median"),
+                "mean_nit": _stat(m, "mean_nit", "mean"),
+                "converged_rate": float(conv.mean()) if conv.notna().any() else nan,
                 "runs": len(m),
                 "mean_error": float(m["mean_error"].mean()),
                 "error_diff": float(d_err.mean()),
@@ -104,8 +184,9 @@ def summarize_frontier(
             if method in reg.columns and len(reg):
                 r = 100 * reg[method].to_numpy(float)
                 d = r - 100 * reg[base].to_numpy(float)
-                r_lo, r_hi = _ci(r, seed, n_boot, **key, statistic="regret")
-                d_lo, d_hi = _ci(d, seed, n_boot, **key, statistic="regret_diff")
+                run_of = reg.index.get_level_values("run").to_numpy()
+                r_lo, r_hi = _cluster_ci(r, run_of)
+                d_lo, d_hi = _cluster_ci(d, run_of)
                 row.update(
                     states=int(r.size),
                     regret_pct=float(r.mean()),
@@ -120,12 +201,20 @@ def summarize_frontier(
 
 
 class Paired(NamedTuple):
-    """Mean of paired differences d = x(a) − x(b) with its 95% bootstrap CI over n pairs."""
+    """Mean of paired differences d = x(a) − x(b) over n pairs in ``clusters`` runs, with its
+    95% cluster-t CI (``low``, ``high``; standard error ``se`` with ``df`` = clusters − 1
+    degrees of freedom: :func:`cluster_mean_ci`) and, for comparison, the 95% percentile
+    bootstrap CI over pairs that the exploratory tables used (``boot_low``, ``boot_high``)."""
 
     mean: float
     low: float
     high: float
     n: int
+    se: float = float("nan")
+    df: int = 0
+    clusters: int = 0
+    boot_low: float = float("nan")
+    boot_high: float = float("nan")
 
 
 #: the paired measures: (table, value column, pairing index, scale): closed-loop mean
@@ -148,9 +237,10 @@ def paired_difference(
     r"""d = x(``a``) − x(``b``) on ``model``, paired over what both share: ``measure`` =
     "error" (``table`` = the runs table; x = a run's mean location error, m; pairs = runs) or
     "regret" (``table`` = the regret table; x = relative regret in percent, so d is in
-    percentage points; pairs = belief states (run, step)). Mean and 95% percentile-bootstrap
-    CI (stream keyed on model, a, b and the measure). Unknown model, member or measure, or
-    fewer than 2 pairs: ValueError naming it."""
+    percentage points; pairs = belief states (run, step)). Mean, its 95% cluster-t CI over
+    runs and, for comparison, the percentile-bootstrap CI over pairs (stream keyed on model,
+    a, b and the measure): :class:`Paired`. Unknown model, member or measure, or fewer than 2
+    runs: ValueError naming it."""
     if measure not in _MEASURES:
         raise ValueError(f"measure: {measure!r} (allowed: {', '.join(_MEASURES)})")
     _, col, index, scale = _MEASURES[measure]
@@ -165,10 +255,15 @@ def paired_difference(
             )
     wide = g.pivot_table(index=index, columns="method", values=col).dropna(subset=[a, b])
     d = scale * (wide[a] - wide[b]).to_numpy(float)
-    if d.size < 2:
-        raise ValueError(f"{a} − {b} on {model!r}: {d.size} pair(s) (allowed: at least 2)")
+    runs = wide.index.get_level_values("run").to_numpy()
+    ci = cluster_mean_ci(d, runs)
+    if ci is None:
+        raise ValueError(
+            f"{a} − {b} on {model!r}: {d.size} pair(s) in {np.unique(runs).size} run(s) "
+            "(allowed: at least 2 runs)"
+        )
     lo, hi = _ci(d, seed, n_boot, model=model, a=a, b=b, statistic=f"paired_{measure}")
-    return Paired(float(d.mean()), lo, hi, int(d.size))
+    return Paired(float(d.mean()), ci.low, ci.high, int(d.size), ci.se, ci.df, ci.df + 1, lo, hi)
 
 
 BUDGET_COLUMNS = ["model", "member", "family", "plan_ms", "fits", "largest_fitting", "largest_ms"]

@@ -24,6 +24,7 @@ depend on the method set: more methods can only lower it.
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Mapping
 from typing import Any
 
@@ -40,14 +41,19 @@ from rsmhp.experiments.decisions_uav import (
     merge_variant,
 )
 from rsmhp.parallel import parallel_map
+from rsmhp.seeding import job_rng
 from rsmhp.uav import methods
+from rsmhp.uav.planner import Belief
 from rsmhp.uav.simulation import UAVSetup
 
 __all__ = [
     "FRONTIER_RUN_COLUMNS",
+    "TIMING_COLUMNS",
     "frontier_contracts",
     "recording_setup",
     "run_frontier_model",
+    "time_planners",
+    "timing_contract",
     "variant",
 ]
 
@@ -66,7 +72,14 @@ FRONTIER_RUN_COLUMNS = [
     "detect_rate",
     "lost",
     "plan_ms",
+    "mean_nit",
+    "work_per_step",
+    "converged_rate",
 ]
+
+#: one row per (repeat, belief state, method) of the interleaved timing (rule
+#: ``decisions_frontier_timing``): the wall time of one plan call (ms) and its work
+TIMING_COLUMNS = ["model", "method", "repeat", "run", "step", "slot", "ms", "work"]
 
 
 def variant(models: list[Mapping[str, Any]], name: str) -> Mapping[str, Any]:
@@ -91,6 +104,7 @@ def frontier_contracts(cfg: Mapping[str, Any], model: str) -> tuple[Contract, Co
         text=("model", "method", "family"),
         boolean=("lost",),
         integer=("N_T", "N", "M", "run"),
+        nullable=("converged_rate",),  # NaN for a planner without an optimiser
         keys=("method", "run"),
         expected=pd.DataFrame(keys, columns=["method", "run"]),
         values={"model": model},
@@ -137,6 +151,9 @@ def run_frontier_model(
             "detect_rate": s.get("detect_rate", 1.0),
             "lost": bool(s["final_error"] > loss),
             "plan_ms": 1e3 * s["plan_seconds"] / setup.steps,
+            "mean_nit": s["mean_nit"],
+            "work_per_step": s["work_per_step"],
+            "converged_rate": s["converged_rate"],
         }
         for s in summaries
     ]
@@ -181,3 +198,87 @@ def recording_setup(
     chosen = sorted((run[m] for m in members), key=lambda m: m.sort_key())
     setup = UAVSetup.from_config(merge_variant(uav, variant(models, model)))
     return setup, [base, *chosen]
+
+
+def timing_contract(cfg: Mapping[str, Any], model: str) -> Contract:
+    """What the rule ``decisions_frontier_timing`` writes for ``model``: one row per (repeat,
+    belief state, method) of ``cfg["timing"]`` (``decisions.frontier``)."""
+    names = list(methods.from_config(cfg["methods"], "decisions.frontier.methods"))
+    t = cfg["timing"]
+    keys = [
+        (m, rep, run, step)
+        for rep in range(int(t["repeats"]))
+        for run in range(int(t["runs"]))
+        for step in sorted(set(int(k) for k in t["steps"]))
+        for m in names
+    ]
+    return Contract(
+        rule="decisions_frontier_timing",
+        columns=TIMING_COLUMNS,
+        text=("model", "method"),
+        integer=("repeat", "run", "step", "slot", "work"),
+        keys=("method", "repeat", "run", "step"),
+        expected=pd.DataFrame(keys, columns=["method", "repeat", "run", "step"]),
+        values={"model": model},
+    )
+
+
+def time_planners(
+    uav: Mapping[str, Any],
+    models: list[Mapping[str, Any]],
+    cfg: Mapping[str, Any],
+    model: str,
+    seed: int,
+) -> pd.DataFrame:
+    r"""Interleaved wall-clock timing of every method's plan call (:data:`TIMING_COLUMNS`).
+
+    At the belief states of NBO runs ``cfg["timing"]["runs"]`` at ``steps`` (the open-loop
+    study's states, :func:`rsmhp.experiments.decisions_uav.belief_states`), every method
+    plans once per state and repeat, **round robin**: at state s of repeat r the methods are
+    called in the table order rotated by :math:`(r \cdot S + s) \bmod M` (M methods, S
+    states), so every method takes every slot equally often and a slow drift of the machine
+    (frequency, cache, another process) is spread over all methods rather than loaded on the
+    ones that run last. Each call is timed alone with ``time.perf_counter`` on one BLAS
+    thread, with the step's own stream (the closed loop's key, so the plan is the one the
+    closed loop makes at that belief). The rule holds the machine's cores while it runs, so
+    nothing runs beside it on the reference machine (2 cores). Repeats measure the spread of
+    the time from one pass to the next; the plan and its ``work`` (model steps) are the same
+    in every repeat."""
+    uav_cfg = merge_variant(uav, variant(models, model))
+    setup = UAVSetup.from_config(uav_cfg)
+    planners = methods.from_config(cfg["methods"], "decisions.frontier.methods")
+    t = cfg["timing"]
+    with threadpool_limits(limits=1):
+        states = belief_states(setup, model, seed, range(int(t["runs"])), t["steps"])
+        built = [(m, planners[m].planner(setup)) for m in planners]
+        n_m, n_s = len(built), len(states)
+        rows = []
+        for rep in range(int(t["repeats"])):
+            log.info("frontier timing %s: repeat %d of %d", model, rep + 1, t["repeats"])
+            for si, st in enumerate(states):
+                belief = Belief(st.uav, st.x_hat, st.P_hat)
+                shift = (rep * n_s + si) % n_m
+                for slot in range(n_m):
+                    name, planner = built[(slot + shift) % n_m]
+                    method = planners[name]
+                    rng = (
+                        job_rng(seed, "uav_plan", run=st.run, step=st.step + 1, **method.job_key())
+                        if method.uses_rng
+                        else None
+                    )
+                    t0 = time.perf_counter()
+                    res = planner.plan(belief, st.warm, rng)
+                    ms = 1e3 * (time.perf_counter() - t0)
+                    rows.append(
+                        {
+                            "model": model,
+                            "method": name,
+                            "repeat": rep,
+                            "run": st.run,
+                            "step": st.step,
+                            "slot": slot,
+                            "ms": ms,
+                            "work": int(res.work),
+                        }
+                    )
+    return pd.DataFrame(rows, columns=TIMING_COLUMNS)

@@ -30,18 +30,32 @@ _ROWS = (
 )
 
 
+#: the figure's two compute axes: (summary column, axis label)
+_UNITS = (
+    ("plan_ms", "planning ms per step (interleaved timing, median)"),
+    ("work_per_step", "model steps per planning step (machine-independent)"),
+)
+
+
 def frontier_figure(summary: pd.DataFrame, budget_ms: float | None = None) -> plt.Figure:
-    """The frontier of ``summary`` (:func:`rsmhp.analysis.frontier.summarize_frontier`),
-    with the planning budget ``budget_ms`` (ms per step) marked if given."""
+    """The frontier of ``summary`` (:func:`rsmhp.analysis.frontier.summarize_frontier`): per
+    model two columns of panels, quality against planning time and against model steps per
+    planning step (a unit the summary does not have, e.g. an older table without
+    ``work_per_step``, is left out), with the planning budget ``budget_ms`` (ms per step)
+    marked on the time axis if given."""
     theme()
     models = list(dict.fromkeys(summary["model"]))
     if not models:
         raise ValueError("frontier summary is empty")
+    units = [
+        u for u in _UNITS if u[0] in summary and np.isfinite(summary[u[0]].to_numpy(float)).any()
+    ]
     fams = {c.family: c for c in methods.families()}
+    cols = [(model, unit) for model in models for unit in units]
     fig, axes = plt.subplots(
-        2, len(models), figsize=(4.6 * len(models), 7.0), squeeze=False, sharex=True
+        2, len(cols), figsize=(4.2 * len(cols), 7.0), squeeze=False, sharex="col"
     )
-    for j, model in enumerate(models):
+    for j, (model, (xcol, xlabel)) in enumerate(cols):
         s = summary[summary["model"] == model]
         for i, (col, label) in enumerate(_ROWS):
             ax = axes[i, j]
@@ -49,12 +63,12 @@ def frontier_figure(summary: pd.DataFrame, budget_ms: float | None = None) -> pl
             for fam, g in s.groupby("family", sort=False):
                 if fams[fam].baseline:
                     continue
-                g = g.sort_values("plan_ms")
+                g = g.sort_values(xcol)
                 y = g[col].to_numpy(float)
                 lo = y - g[f"{col}_low"].to_numpy(float)
                 hi = g[f"{col}_high"].to_numpy(float) - y
                 ax.errorbar(
-                    g["plan_ms"],
+                    g[xcol],
                     y,
                     yerr=np.vstack([lo, hi]),
                     color=fams[fam].colour,
@@ -64,7 +78,7 @@ def frontier_figure(summary: pd.DataFrame, budget_ms: float | None = None) -> pl
                     lw=1.4,
                     label=fams[fam].family_label,
                 )
-            if budget_ms is not None:
+            if budget_ms is not None and xcol == "plan_ms":
                 ax.axvline(budget_ms, color="0.35", lw=1.0, ls=":", label="budget")
             ax.set_xscale("log")
             # plain numbers on the decades and 2, 5 between them; no crowded minor labels
@@ -74,7 +88,7 @@ def frontier_figure(summary: pd.DataFrame, budget_ms: float | None = None) -> pl
             if i == 0:
                 ax.set_title(model)
             if i == 1:
-                ax.set_xlabel("planning ms per step (median over runs)")
+                ax.set_xlabel(xlabel)
             if j == 0:
                 ax.set_ylabel(label)
     axes[0, -1].legend(fontsize="small", loc="best")

@@ -31,6 +31,10 @@ def _frontier_table(summary: pd.DataFrame) -> str:
             "model": summary["model"],
             "method": summary["method"].map(method_label),
             "ms/step": summary["plan_ms"],
+            "ms range": ci_cells(summary["plan_lo_ms"], summary["plan_hi_ms"]),
+            "model steps/step": summary["work_per_step"].round(0),
+            "iterations": summary["mean_nit"],
+            "converged %": (100 * summary["converged_rate"]).round(1),
             "runs": summary["runs"].astype(int),
             "error (m)": summary["mean_error"],
             "− NBO (m)": summary["error_diff"],
@@ -49,20 +53,24 @@ def _frontier_table(summary: pd.DataFrame) -> str:
     return markdown_table(t, digits=3, missing="undefined", signed=("− NBO (m)", "− NBO (pp)"))
 
 
-def _budget_table(check: pd.DataFrame) -> str:
+def _budget_table(check: pd.DataFrame, summary: pd.DataFrame) -> str:
+    per = summary.set_index(["model", "method"])["work_per_step"]
+    pairs = zip(check["model"], check["member"], strict=True)
+    work = [float(per.get(pair, float("nan"))) for pair in pairs]
     t = pd.DataFrame(
         {
             "model": check["model"],
             "family": [registry.from_name(m).family_label for m in check["member"]],
             "budget member": check["member"].map(method_label),
             "ms/step": check["plan_ms"],
+            "model steps/step": pd.Series(work).round(0),
             "within budget": ["yes" if f else "no" for f in check["fits"]],
             "largest member within budget (this run)": [
                 method_label(m) if m else "none" for m in check["largest_fitting"]
             ],
         }
     )
-    return markdown_table(t, digits=3)
+    return markdown_table(t, digits=3, missing="not recorded")
 
 
 def frontier_tables(summary: pd.DataFrame, cfg: Mapping[str, Any]) -> dict[str, str]:
@@ -74,7 +82,9 @@ def frontier_tables(summary: pd.DataFrame, cfg: Mapping[str, Any]) -> dict[str, 
     check = budget_check(summary, list(budget["members"]), float(budget["ms_per_step"]))
     return {
         "dec_frontier": _frontier_table(summary),
-        "dec_frontier_budget": _budget_table(check) if len(check) else "(no budget members)",
+        "dec_frontier_budget": (
+            _budget_table(check, summary) if len(check) else "(no budget members)"
+        ),
     }
 
 

@@ -1,0 +1,11 @@
+"""Rule decisions_frontier_timing: interleaved wall-clock timing of every method's plan call
+on one model variant of the equal-compute study."""
+
+from rsmhp.experiments.frontier import time_planners
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake):
+    p = snakemake.params
+    timing = time_planners(p.uav, p.models, p.cfg, snakemake.wildcards.model, p.seed)
+    write_csv(timing, snakemake.output[0])
