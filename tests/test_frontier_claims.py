@@ -39,7 +39,7 @@ METHODS = {
     "sigma": ("sigma", -0.9, 0.001, 0.20),
     "dpw_s30": ("dpw", -3.0, 0.03, 0.45),
 }
-N_RUNS, N_STATES = 12, 10
+N_RUNS, N_STATES = 12, 40  # 20 runs of 2 belief states in the regret table
 
 
 def _tables(methods=METHODS, noise: float = 0.05):
@@ -59,7 +59,7 @@ def _tables(methods=METHODS, noise: float = 0.05):
                  "detect_rate": 1.0, "lost": False, "plan_ms": ms}
             )  # fmt: skip
         for k in range(N_STATES):
-            regret.append({"model": "m", "run": k // 5, "step": k % 5, "method": method,
+            regret.append({"model": "m", "run": k // 2, "step": k % 2, "method": method,
                            "regret_rel": common_r[k] + dr + own_r[k]})  # fmt: skip
     return pd.DataFrame(runs), pd.DataFrame(regret)
 
@@ -75,7 +75,7 @@ def _cfg(members=("rsmhp_nt16", "rqmc_nt16", "sigma", "dpw_s30"), budget=0.5, **
 
 def _claims(cfg=None, tables=None):
     runs, regret = tables if tables is not None else _tables()
-    summary = summarize_frontier(runs, regret, seed=1, n_boot=500)
+    summary = summarize_frontier(runs, regret)
     return {c.id: c for c in frontier_claims(runs, regret, summary, cfg or _cfg(), seed=11)}
 
 
@@ -98,7 +98,29 @@ def test_paired_difference_is_the_mean_of_the_pairs():
     se = 0.05 * np.sqrt(2) / np.sqrt(N_STATES)
     assert abs(p.mean - 0.3) < 4 * se and p.high - p.low < 8 * se
     again = paired_difference(regret, "m", "sigma", "rsmhp_nt16", "regret", seed=3, n_boot=2000)
-    assert again == p  # the stream is keyed on (model, a, b, measure)
+    assert again == p  # the bootstrap stream is keyed on (model, a, b, measure)
+
+
+def test_paired_difference_ci_is_the_t_interval_of_the_run_means():
+    """Oracle: with the same number of states in every run, the leave-one-run-out jackknife
+    of the mean equals Student's t interval of the per-run means (G - 1 df); one value per
+    run (closed loop) is Student's t interval itself. The bootstrap CI is kept beside it."""
+    from rsmhp.stats import mean_ci
+
+    runs, regret = _tables()
+    g = regret.pivot_table(index=["run", "step"], columns="method", values="regret_rel")
+    per_run = (100 * (g["sigma"] - g["rsmhp_nt16"])).groupby(level="run").mean().to_numpy()
+    p = paired_difference(regret, "m", "sigma", "rsmhp_nt16", "regret", seed=3, n_boot=2000)
+    m, lo, hi = mean_ci(per_run)
+    assert (p.clusters, p.df) == (N_STATES // 2, N_STATES // 2 - 1)
+    assert (p.mean, p.low, p.high) == pytest.approx((m, lo, hi), rel=1e-12, abs=1e-12)
+    assert p.se == pytest.approx(per_run.std(ddof=1) / np.sqrt(per_run.size), rel=1e-12)
+    assert np.isfinite(p.boot_low) and p.boot_low < p.mean < p.boot_high
+    w = runs.pivot(index="run", columns="method", values="mean_error")
+    d = paired_difference(runs, "m", "dpw_s30", "nbo", "error", seed=3, n_boot=500)
+    assert (d.low, d.high) == pytest.approx(mean_ci((w["dpw_s30"] - w["nbo"]).to_numpy())[1:])
+    with pytest.raises(ValueError, match="at least 2 runs"):
+        paired_difference(regret[regret["run"] == 0], "m", "sigma", "nbo", "regret", 3, 100)
 
 
 @pytest.mark.parametrize(
@@ -117,7 +139,7 @@ def test_paired_difference_refuses_bad_input(args, match):
 
 def test_budget_check_against_hand_picked_times():
     runs, regret = _tables()
-    summary = summarize_frontier(runs, regret, seed=1, n_boot=200)
+    summary = summarize_frontier(runs, regret)
     c = budget_check(summary, ["rsmhp_nt16", "rqmc_nt16", "sigma", "dpw_s30"], 0.5)
     c = c.set_index("member")
     assert c.loc["rsmhp_nt16", "fits"] and c.loc["rsmhp_nt16", "largest_fitting"] == "rsmhp_nt64"
@@ -170,7 +192,16 @@ def test_each_verdict_is_its_rule_applied_to_the_key_number():
     # DPW − MC error = -2 m: better, while its open-loop plans are worse (+3.2 pp): contrary
     assert claims["FR-3-m"].key.value == pytest.approx(-2.0, abs=0.1)
     assert claims["FR-3-m"].verdict == "supported"
-    assert claims["FR-3-m"].contrary.startswith("its open-loop plans are worse")
+    # the open-loop regret (+3 pp) scores plan steps below the tree's depth: reported, not
+    # contrary evidence to a closed-loop claim
+    assert "open-loop" not in claims["FR-3-m"].contrary
+    assert "also those below the tree's depth" in claims["FR-3-m"].measured
+    # the p-value behind each verdict: FR-3 supported <=> CI excludes 0 <=> p < 0.05
+    for cid in claims:
+        assert 0 <= claims[cid].key.p_value <= 1
+    assert claims["FR-3-m"].key.p_value < 0.05
+    # FR-1 equivalent: both boundaries ±0.1 pp excluded, so p (the larger) < 0.05 too
+    assert claims["FR-1-m"].key.p_value < 0.05
 
 
 def test_verdicts_flip_where_the_data_cross_the_rules():
@@ -209,7 +240,7 @@ def test_section_states_every_claim_and_the_budget():
     from rsmhp.narrative.frontier import frontier_section, frontier_tables
 
     runs, regret = _tables()
-    summary = summarize_frontier(runs, regret, seed=1, n_boot=200)
+    summary = summarize_frontier(runs, regret)
     cfg = {**_cfg(), "runs": N_RUNS, "regret_runs": 2, "regret_steps": [0, 1, 2, 3, 4],
            "track_loss_error": 50.0}  # fmt: skip
     tables = frontier_tables(summary, cfg)

@@ -123,3 +123,72 @@ def test_non_inferior_text_and_bad_margin():
     for bad in (0.0, -1.0, "0.1", None):
         with pytest.raises(ValueError, match="margin must be a number > 0"):
             non_inferior("d", bad, margin_text="x")
+
+
+# ------------------------------------------------------------ p-values and Holm's correction
+
+
+def test_decisive_p_is_below_005_exactly_when_the_t_interval_excludes_the_boundary():
+    import numpy as np
+    from scipy import stats as st
+
+    from rsmhp.verdicts import decisive_p
+
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        est, se, df = rng.normal(0, 1), rng.uniform(0.05, 1), int(rng.integers(2, 60))
+        half = st.t.ppf(0.975, df) * se
+        lo, hi = est - half, est + half
+        assert (decisive_p("supported", est, se, df, [(0.0, "above")]) < 0.05) == (lo > 0)
+        assert (decisive_p("supported", est, se, df, [(0.0, "below")]) < 0.05) == (hi < 0)
+        m = abs(rng.normal(0, 1))
+        peq = decisive_p("equivalent", est, se, df, [(-m, "above"), (m, "below")])
+        assert (peq < 0.05) == (-m < lo and hi < m)
+    assert decisive_p("supported", 1.0, 0.0, 5, [(0.0, "above")]) == 0.0
+    assert decisive_p("supported", 1.0, 0.0, 5, [(0.0, "below")]) == 1.0
+    with pytest.raises(ValueError, match="boundaries"):
+        decisive_p("supported", 1.0, 0.1, 5, [])
+
+
+def _claim(cid: str, verdict: str, p: float | None):
+    from rsmhp.ledger import Claim, KeyNumber
+
+    key = KeyNumber("d", 1.0, 0.5, 1.5, reproducible="statistical", null=0.0, p_value=p)
+    return Claim(cid, "c", "p", key, verdict, "rule text", part="beyond")
+
+
+def test_holm_correct_downgrades_what_the_family_no_longer_rejects():
+    from rsmhp.stats import holm
+    from rsmhp.verdicts import holm_correct
+
+    claims = [
+        _claim("FR-1-a", "supported", 0.001),
+        _claim("FR-2-a", "equivalent", 0.03),
+        _claim("HZ-1-a", "not supported", 0.02),
+        _claim("HZ-3-a", "inconclusive", 0.4),
+        _claim("UAV-1", "supported", 0.04),  # outside the family: untouched
+        _claim("FR-9-a", "supported", None),  # no p-value: untouched
+    ]
+    out = holm_correct(claims)
+    adj = holm([0.001, 0.03, 0.02, 0.4])
+    assert [c.key.p_holm for c in out[:4]] == pytest.approx(list(adj))
+    kept = ["supported", "equivalent", "not supported"]
+    want = [v if a < 0.05 else "inconclusive" for v, a in zip(kept, adj, strict=False)]
+    want.append("inconclusive")
+    assert [c.verdict for c in out[:4]] == want
+    assert out[1].verdict == "inconclusive" and "becomes inconclusive" in out[1].rule
+    assert out[4] == claims[4] and out[5] == claims[5]
+    assert holm_correct([claims[4]]) == [claims[4]]
+
+
+def test_holm_sections_corrects_across_sections_and_keeps_their_claims():
+    from rsmhp.ledger import Section
+    from rsmhp.verdicts import holm_correct, holm_sections
+
+    a = Section("a", "A", 1, "", [_claim("FR-1-x", "supported", 0.03), _claim("X-1", "supported", None)])
+    b = Section("b", "B", 2, "", [_claim("HZ-1-x", "supported", 0.04)])
+    out = holm_sections([a, b])
+    want = holm_correct([*a.claims, *b.claims])
+    assert [c.id for c in out[0].claims] == ["FR-1-x", "X-1"] and out[0].title == "A"
+    assert [*out[0].claims, *out[1].claims] == want
+    assert out[1].claims[0].verdict == "inconclusive"  # 2 x 0.03 = 0.06, then max(0.06, 0.04)

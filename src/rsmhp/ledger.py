@@ -64,6 +64,11 @@ class KeyNumber:
     reproducible: str = "bitwise"
     digits: int = 3
     null: float | None = None
+    #: p-value of the test behind the verdict (:func:`rsmhp.verdicts.decisive_p`), where the
+    #: claim belongs to a family corrected for multiplicity; ``p_holm``: its Holm-adjusted
+    #: value over that family (:func:`rsmhp.verdicts.holm_correct`)
+    p_value: float | None = None
+    p_holm: float | None = None
 
     def __post_init__(self) -> None:
         if self.reproducible not in REPRODUCIBILITY:

@@ -20,12 +20,28 @@ boundary behaviour is tested in ``tests/test_verdicts.py``.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Mapping
+import dataclasses
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
-from rsmhp.ledger import STATEMENT_VERDICTS
+import numpy as np
+from scipy import stats as _st
 
-__all__ = ["Case", "Facts", "Rule", "at_most", "ci_side", "non_inferior"]
+from rsmhp.ledger import STATEMENT_VERDICTS, Claim, Section
+from rsmhp.stats import holm
+
+__all__ = [
+    "HOLM_FAMILY",
+    "Case",
+    "Facts",
+    "Rule",
+    "at_most",
+    "ci_side",
+    "decisive_p",
+    "holm_correct",
+    "holm_sections",
+    "non_inferior",
+]
 
 Facts = Mapping[str, float]
 
@@ -173,3 +189,79 @@ def non_inferior(
         ),
         otherwise="inconclusive",
     )
+
+
+def decisive_p(
+    verdict: str, estimate: float, se: float, df: float, boundaries: Sequence[tuple[float, str]]
+) -> float:
+    r"""The p-value behind a CI verdict. Every CI rule here reads "the 95% CI lies strictly
+    above (or below) a boundary b" (0, or ±m): with a t interval
+    :math:`\hat\theta \pm t_{df}\,\mathrm{se}` that holds exactly when
+    :math:`p = \min(1, 2\,(1 - T_{df}((\hat\theta - b)/\mathrm{se})))` ("above"; the mirror
+    image for "below") is below 0.05. ``boundaries`` are the (b, side) pairs the verdict's case
+    needs; a case that needs several (``equivalent``: above −m and below +m) has the largest
+    of their p-values; for ``inconclusive`` give the claimed case's boundary.
+    ``se == 0``: 0 when the estimate is strictly on the side, else 1."""
+    if not boundaries:
+        raise ValueError("boundaries: give at least one (boundary, side) of the verdict's case")
+    if not (np.isfinite(se) and se >= 0 and df > 0):
+        raise ValueError(f"se must be finite >= 0 and df > 0, got se={se!r}, df={df!r}")
+    ps = []
+    for b, side in boundaries:
+        if side not in ("above", "below"):
+            raise ValueError(f"side must be 'above' or 'below', got {side!r}")
+        dist = float(estimate) - float(b) if side == "above" else float(b) - float(estimate)
+        if se == 0:
+            ps.append(0.0 if dist > 0 else 1.0)
+        else:
+            ps.append(float(min(1.0, 2 * _st.t.sf(dist / se, df))))
+    return max(ps)
+
+
+#: the claim-id prefixes of the family Holm's correction runs over: the benchmark's own
+#: comparisons of planners and horizons (equal compute, long horizons)
+HOLM_FAMILY = ("FR-", "HZ-")
+
+
+def holm_correct(
+    claims: Iterable[Claim], family: Sequence[str] = HOLM_FAMILY, alpha: float = 0.05
+) -> list[Claim]:
+    """Holm's step-down correction over the claims whose id starts with one of ``family``
+    and whose key number has a ``p_value`` (:func:`decisive_p`): each gets ``p_holm``, the
+    Holm-adjusted p-value over that family (:func:`rsmhp.stats.holm`), and a decisive
+    verdict (``supported``, ``not supported``, ``equivalent``) whose ``p_holm`` is not below
+    ``alpha`` becomes ``inconclusive``, the rule's text saying so. Other claims are returned
+    unchanged, in the input order."""
+    claims = list(claims)
+    idx = [
+        i
+        for i, c in enumerate(claims)
+        if c.id.startswith(tuple(family)) and c.key.p_value is not None
+    ]
+    if not idx:
+        return claims
+    adjusted = holm(np.array([claims[i].key.p_value for i in idx], dtype=float))
+    out = list(claims)
+    for i, p in zip(idx, adjusted, strict=True):
+        c = claims[i]
+        key = dataclasses.replace(c.key, p_holm=float(p))
+        verdict, rule = c.verdict, c.rule
+        note = (
+            f" Holm's correction over the {len(idx)} claims {', '.join(family)}*: adjusted "
+            f"p = {p:.3g}"
+        )
+        if verdict in ("supported", "not supported", "equivalent") and p >= alpha:
+            note += f" ≥ {alpha:g}, so {verdict} at the 95% level alone becomes inconclusive"
+            verdict = "inconclusive"
+        out[i] = dataclasses.replace(c, key=key, verdict=verdict, rule=rule + "." + note)
+    return out
+
+
+def holm_sections(sections: Sequence[Section], alpha: float = 0.05) -> list[Section]:
+    """``sections`` with :func:`holm_correct` applied over all their claims at once (the
+    report's family spans the equal-compute and long-horizon sections), each section keeping
+    its own claims in their order."""
+    sections = list(sections)
+    flat = [c for s in sections for c in s.claims]
+    fixed = iter(holm_correct(flat, alpha=alpha))
+    return [dataclasses.replace(s, claims=[next(fixed) for _ in s.claims]) for s in sections]
