@@ -224,3 +224,61 @@ def test_compiled_plan_reports_its_counters():
     x0 = np.clip(warm / UAV.control_scale, -1, 1).reshape(1, -1)
     assert res.cost_warm == pytest.approx(p.costs(x0)[0], rel=1e-12)
     np.testing.assert_allclose(res.uav_path, kinematics.rollout(p.uav_state, res.controls, UAV))
+
+
+def test_work_counts_two_passes_per_evaluation_and_convergence_follows_the_status():
+    """Oracle: work = 2 T H x evaluations (forward and adjoint pass per gradient evaluation);
+    converged is True exactly for the tolerance stops (boxqn status 0/1; scipy status 0)."""
+    rng = np.random.default_rng(5)
+    prob, warm = _belief_problem(rng, SENSOR, 20)
+    p = prob()
+    res = BoxQN().minimise(p, warm)
+    T, H = p.target_xy.shape[0], p.params.horizon
+    assert res.work == 2 * T * H * res.n_kernel_calls
+    assert res.converged == (res.diagnostics["status"] in (0.0, 1.0))
+    tight = PlanningProblem(p.uav_state, p.P_hat, p.target_xy, UAV, MODEL, SENSOR,
+                            PlannerParams(6, 1, 60))  # fmt: skip
+    one = BoxQN().minimise(tight, warm)
+    assert one.nit == 1 and one.converged is False and one.diagnostics["status"] == 2.0
+    q = prob()
+    s = LBFGSB().minimise(q, warm)
+    assert s.work == 2 * T * H * q.n_kernel_calls and isinstance(s.converged, bool)
+
+
+def test_restarts_never_worsen_the_plan_and_add_their_work():
+    """The restarts keep the warm-start plan unless a fixed start finds a lower own cost;
+    their work and iterations add up; the starts are held controls inside the box (the 2-D
+    Halton points, bases 2 and 3, mapped to [-1, 1]), and the same for every call (no stream)."""
+    from rsmhp.uav.methods.base import Hypotheses
+    from rsmhp.uav.planner import Belief, restart_starts
+
+    starts = restart_starts(6, 5)
+    assert starts.shape == (5, 12) and np.all(np.abs(starts) <= 1)
+    np.testing.assert_allclose(starts[:3, :2], [[0, -1 / 3], [-1 / 2, 1 / 3], [1 / 2, -7 / 9]])
+    assert np.all(starts[:, 0::2] == starts[:, [0]]) and np.all(starts[:, 1::2] == starts[:, [1]])
+    assert restart_starts(6, 5) is starts and not starts.flags.writeable
+    rng = np.random.default_rng(11)
+    P0, _, tgt = _inputs(rng, n_t=9)
+    hyp = Hypotheses.equal(np.concatenate([tgt, np.zeros((9, 6, 2))], axis=2))
+    belief = Belief(np.array([-400.0, 300.0, 20.0, 0.5]), np.zeros(4), P0)
+
+    def planner(k):
+        params = PlannerParams(6, 30, 60, restarts=k)
+        return SampledCostPlanner(lambda b, r: hyp, UAV, MODEL, SENSOR, params)
+
+    warm = np.zeros((6, 2))
+    base = planner(0).plan(belief, warm, None)
+    more = planner(4).plan(belief, warm, None)
+    assert more.cost <= base.cost
+    assert more.cost_warm == base.cost_warm and 0 <= more.diagnostics["restart"] <= 4
+    singles = [base] + [
+        BoxQN().minimise(
+            PlanningProblem(belief.uav, P0, tgt, UAV, MODEL, SENSOR, PLANNER),
+            (starts[i] * np.tile(UAV.control_scale, 6)).reshape(6, 2),
+        )
+        for i in range(4)
+    ]
+    assert more.work == sum(r.work for r in singles)
+    assert more.cost == min(r.cost for r in singles)
+    with pytest.raises(ValueError, match="restarts"):
+        PlannerParams(6, 30, 60, restarts=-1)

@@ -60,6 +60,7 @@ __all__ = [
     "lbfgsb",
     "plan",
     "polish",
+    "restart_starts",
     "shift_plan",
 ]
 
@@ -77,11 +78,17 @@ class PlannerParams:
     maxiter: int
     maxfun: int
     optimiser: str = "boxqn"
+    #: further optimisations of a sampled-cost planner from fixed starts (:func:`restart_starts`),
+    #: beside the one from the warm start; the lowest own cost wins
+    restarts: int = 0
 
     def __post_init__(self) -> None:
         for name in ("horizon", "maxiter", "maxfun"):
             value = guards.positive_int(f"PlannerParams.{name}", getattr(self, name))
             object.__setattr__(self, name, value)  # 6.0 -> 6 (ints are kept as they are)
+        object.__setattr__(
+            self, "restarts", guards.integer("PlannerParams.restarts", self.restarts, minimum=0)
+        )
         if self.optimiser not in OPTIMISER_NAMES:
             raise ValueError(
                 f"PlannerParams.optimiser must be one of {list(OPTIMISER_NAMES)}, "
@@ -97,6 +104,7 @@ class PlannerParams:
             maxiter=p["maxiter"],
             maxfun=p["maxfun"],
             optimiser=p.get("optimiser", "boxqn"),
+            restarts=p.get("restarts", 0),
         )
 
 
@@ -300,6 +308,7 @@ def plan(problem: PlanningProblem, warm_start: np.ndarray, *, check: bool = True
         guards.instance_of("problem", problem, PlanningProblem)
         guards.finite_array("warm_start", warm_start, shape=(problem.params.horizon, 2))
     x0 = np.clip(np.asarray(warm_start, dtype=float).ravel() / problem.scale, -1.0, 1.0)
+    calls = problem.n_kernel_calls
     f0, _ = problem.value_and_grad(x0)
     res = _lbfgsb(problem, x0, problem.params.maxiter, problem.params.maxfun)
     x_best, f_best = (res.x, float(res.fun)) if res.fun <= f0 else (x0, f0)
@@ -311,7 +320,7 @@ def plan(problem: PlanningProblem, warm_start: np.ndarray, *, check: bool = True
         nit=int(res.nit),
         n_kernel_calls=problem.n_kernel_calls,
         uav_path=problem.path(x_best),
-        work=problem.work(problem.n_kernel_calls),  # the cache spares repeats
+        work=problem.work(problem.n_kernel_calls - calls),  # the cache spares repeats
         # scipy's status 0: converged (projected gradient or relative decrease); 1: a budget
         converged=bool(res.status == 0),
     )
@@ -380,6 +389,33 @@ def polish(
     return x, f
 
 
+def _halton(i: int, base: int) -> float:
+    """The i-th (i >= 1) term of the van der Corput sequence in ``base``, in (0, 1)."""
+    f, out = 1.0, 0.0
+    while i > 0:
+        f /= base
+        out += f * (i % base)
+        i //= base
+    return out
+
+
+@functools.cache
+def restart_starts(horizon: int, restarts: int) -> np.ndarray:
+    r"""The fixed starts of the restarts, normalised (restarts, 2H), read-only: restart i
+    (i = 1, 2, ...) holds one control :math:`c_i` over the whole horizon, a held turn or
+    acceleration, with :math:`c_i = 2 h_i - 1` and :math:`h_i` the i-th point of the 2-D
+    Halton sequence (bases 2, 3): (0, −1/3) (hold speed, gentle turn), (−1/2, 1/3),
+    (1/2, −7/9), ... spread over the box. The
+    starts depend on nothing random, so every method and every step gets the same ones
+    (a paired design of the optimiser budget) and a deterministic method needs no stream."""
+    out = np.empty((restarts, 2 * horizon))
+    for i in range(restarts):
+        c = (2 * _halton(i + 1, 2) - 1, 2 * _halton(i + 1, 3) - 1)
+        out[i] = np.tile(c, horizon)
+    out.flags.writeable = False
+    return out
+
+
 @dataclass(frozen=True)
 class SampledCostPlanner:
     """The planner of every sampling method: draw the method's weighted hypotheses for the
@@ -413,5 +449,28 @@ class SampledCostPlanner:
             check=False,
         )
         res = self.optimiser.minimise(problem, warm_start)
+        if self.params.restarts:
+            res = _restart(self.optimiser, problem, res, self.params.restarts)
         res.hypotheses = hyp
         return res
+
+
+def _restart(
+    optimiser: Optimiser, problem: PlanningProblem, first: PlanResult, restarts: int
+) -> PlanResult:
+    """The best of ``first`` and ``restarts`` optimisations from :func:`restart_starts` (the
+    lowest own cost; ties keep the earlier), with the work and iterations of all of them and
+    ``diagnostics["restart"]`` = which one won (0: the warm start)."""
+    best, work, nit = first, first.work, first.nit
+    winner = 0
+    starts = restart_starts(problem.params.horizon, restarts)
+    for i, x0 in enumerate(starts, start=1):
+        res = optimiser.minimise(problem, problem.controls(x0))
+        work += res.work
+        nit += res.nit
+        if res.cost < best.cost:
+            best, winner = res, i
+    best.work, best.nit = work, nit
+    best.cost_warm = first.cost_warm
+    best.diagnostics = {**best.diagnostics, "restart": float(winner)}
+    return best
