@@ -4,7 +4,10 @@ Oracles: a method's estimate is its planning cost on its own hypotheses (Plannin
 the hypotheses it draws with the row's stream); the reference is the mean of the per-hypothesis
 costs (fused.covariance_traces); NBO's and the sigma points' estimates do not depend on the
 replicate; the noise-corrected RMSE against a hand computation and, statistically, against a
-known error variance; growth and claims against their rules on tables with known errors.
+known error variance; growth and claims against their rules on tables with known errors; the
+cluster-t CIs against a jackknife over runs written out here and, for a mean of per-run values,
+against the Student-t interval; the runs needed against rsmhp.stats.runs_for_power; the warm
+start beyond the base horizon against the closed loop's hold-the-last-control rule.
 """
 
 from __future__ import annotations
@@ -17,6 +20,7 @@ import numpy as np
 import pandas as pd
 import pytest
 import yaml
+from scipy import stats as sps
 
 from rsmhp.analysis.horizon import rmse_growth, state_errors, summarize_approx
 from rsmhp.contracts import check_table
@@ -112,14 +116,18 @@ def test_estimates_and_reference_against_the_planning_cost(paper_h4):
         np.testing.assert_allclose(got["estimate"], want, rtol=1e-12, err_msg=name)
 
 
-def _table(errors: dict[str, np.ndarray], se: float = 0.0, H: int = 2) -> pd.DataFrame:
+def _table(
+    errors: dict[str, np.ndarray], se: float = 0.0, H: int = 2, steps: int = 1
+) -> pd.DataFrame:
     """Approximation rows of model 'm' at horizon H: per method, estimate = reference x (1 +
-    e) with e[state, plan] given, reference 100, reference SE ``se`` x 100."""
+    e) with e[state, plan] given, reference 100, reference SE ``se`` x 100; state s is step
+    s % ``steps`` of run s // ``steps``."""
     rows = []
     for method, e in errors.items():
         for s in range(e.shape[0]):
             for p in range(e.shape[1]):
-                rows.append({"model": "m", "H": H, "run": s, "step": 0, "method": method,
+                rows.append({"model": "m", "H": H, "run": s // steps, "step": s % steps,
+                             "method": method,
                              "family": method.split("_")[0], "replicate": 0, "plan": p,
                              "estimate": 100.0 * (1 + e[s, p]), "reference": 100.0,
                              "reference_se": 100.0 * se})  # fmt: skip
@@ -136,6 +144,20 @@ def test_bias_and_noise_corrected_rmse_by_hand():
     per = state_errors(_table({"a_1": e}, se=0.01))
     np.testing.assert_allclose(per["b"], e.mean(axis=1))
     np.testing.assert_allclose(per["q"], (e**2).mean(axis=1) - 1e-4)
+    # one state per run: the cluster-t CIs are Student-t intervals of the per-run values (the
+    # RMSE's that of the mean square, square-rooted and floored at 0)
+    lo, hi = _student_t(e.mean(axis=1))
+    assert (s["rel_bias_low"], s["rel_bias_high"]) == pytest.approx((lo, hi), rel=1e-12)
+    lo, hi = _student_t((e**2).mean(axis=1) - 1e-4)
+    assert (s["rel_rmse_low"], s["rel_rmse_high"]) == pytest.approx(
+        (np.sqrt(max(lo, 0.0)), np.sqrt(hi)), rel=1e-12
+    )
+
+
+def _student_t(x: np.ndarray, level: float = 0.95) -> tuple[float, float]:
+    """Student-t interval of the mean of ``x``, written out."""
+    half = sps.t.ppf(0.5 + level / 2, x.size - 1) * x.std(ddof=1) / np.sqrt(x.size)
+    return float(x.mean() - half), float(x.mean() + half)
 
 
 def test_noise_correction_recovers_a_known_error_sd():
@@ -175,8 +197,50 @@ def test_growth_and_its_difference_between_methods():
         rmse_growth(df, "m", "tree_x", 2, 12, seed=1, n_boot=100)
 
 
+def _jackknife_growth(lo: dict, hi: dict, steps: int, method: str, minus: str | None):
+    """(estimate, low, high, se, p) of the RMSE growth by a jackknife over runs written out:
+    leave out run i (its ``steps`` states) at both horizons, recompute the growth from the
+    errors (reference SE 0, so q = mean over plans of e²), and take the t interval with
+    runs − 1 df around the full-sample growth."""
+
+    def growth(keep: np.ndarray) -> float:
+        def g(m: str) -> float:
+            return np.sqrt((hi[m][keep] ** 2).mean()) - np.sqrt((lo[m][keep] ** 2).mean())
+
+        return g(method) - (g(minus) if minus else 0.0)
+
+    n_states = lo[method].shape[0]
+    runs = np.arange(n_states) // steps
+    G = runs.max() + 1
+    full = growth(np.ones(n_states, bool))
+    loo = np.array([growth(runs != i) for i in range(G)])
+    se = np.sqrt((G - 1) / G * ((loo - loo.mean()) ** 2).sum())
+    half = sps.t.ppf(0.975, G - 1) * se
+    return full, full - half, full + half, se, 2 * sps.t.sf(abs(full) / se, G - 1)
+
+
+@pytest.mark.parametrize("minus", [None, "mc_x"])
+def test_growth_ci_is_the_jackknife_over_runs(minus):
+    """5 runs of 2 belief states each: the published CI is the cluster-t interval of a
+    jackknife that leaves out whole runs (written out in _jackknife_growth), with its t-test
+    p-value; the percentile bootstrap over runs is kept beside it."""
+    rng = np.random.default_rng(12)
+    lo = {m: rng.normal(0, 0.01, (10, 4)) for m in ("tree_x", "mc_x")}
+    hi = {"tree_x": rng.normal(0, 0.03, (10, 4)), "mc_x": rng.normal(0, 0.015, (10, 4))}
+    df = pd.concat([_table(lo, H=2, steps=2), _table(hi, H=24, steps=2)], ignore_index=True)
+    g = rmse_growth(df, "m", "tree_x", 2, 24, seed=3, n_boot=2000, minus=minus)
+    est, low, high, se, p = _jackknife_growth(lo, hi, 2, "tree_x", minus)
+    assert (g.n, g.runs, g.df) == (10, 5, 4)
+    assert g.mean == pytest.approx(est, rel=1e-12)
+    assert (g.low, g.high, g.se) == pytest.approx((low, high, se), rel=1e-10)
+    assert g.p_value == pytest.approx(p, rel=1e-10)
+    # the bootstrap CI is the 2.5% and 97.5% quantiles of resampled growths: a different
+    # interval around the same estimate
+    assert g.boot_low < g.mean < g.boot_high and (g.boot_low, g.boot_high) != (g.low, g.high)
+
+
 def test_claims_follow_their_rules():
-    from rsmhp.claims.horizon import KEY, horizon_claims, hz1_rule, hz2_rule
+    from rsmhp.claims.horizon import KEY, horizon_claims, horizon_evidence, hz1_rule, hz2_rule
 
     rng = np.random.default_rng(4)
     lo = {m: rng.normal(0, 0.01, (25, 6)) for m in ("nbo", "tree_n4_m256", "rsmhp_nt256")}
@@ -197,6 +261,21 @@ def test_claims_follow_their_rules():
         assert claims[cid].part == "beyond"
     assert claims["HZ-1-m"].verdict == "supported"  # NBO's error grows 1% -> 3.6%
     assert claims["HZ-2-m"].verdict == "not supported"  # here Monte Carlo's grows, the tree's not
+    # the primary test's p-value: a t-test that the CI inverts (excludes 0 iff p < 0.05); the
+    # bootstrap verdict is the rule's on the bootstrap CI
+    evidence = horizon_evidence(df, summary, cfg, seed=2)
+    assert [e.claim for e in evidence] == list(claims.values())
+    for e, rule in zip(evidence, (hz1_rule(4, 24), hz2_rule("tree_n4_m256", "rsmhp_nt256", 4,
+                       24)), strict=True):  # fmt: skip
+        k = e.claim.key
+        assert k.p_value == e.p_value and e.df == 25 - 1
+        assert (e.p_value < 0.05) == (k.ci_low > 0 or k.ci_high < 0)
+        # a decisive verdict: the two-sided t-test of 0, with the se the CI implies
+        se = (k.ci_high - k.ci_low) / 2 / sps.t.ppf(0.975, e.df)
+        assert e.p_value == pytest.approx(2 * sps.t.sf(abs(k.value) / se, e.df), rel=1e-6)
+        assert e.boot_verdict == rule.verdict({f"{KEY}_low": e.boot_low / 100,
+                                               f"{KEY}_high": e.boot_high / 100})  # fmt: skip
+        assert "p = " in e.claim.measured and "percentile bootstrap" in e.claim.measured
     # with H = 2 and 24 only, the tree (64 leaves at H = 2) is not pruned at H = 2: HZ-2 starts
     # at the first pruned horizon, here only 24, so there is no HZ-2
     df2 = df.assign(H=df["H"].replace({4: 2}))
@@ -279,17 +358,60 @@ def test_advantage_growth_and_hz3_against_their_rule():
     D = (w[(24, "rsmhp_nt256")] - w[(24, "nbo")]) - (w[(2, "rsmhp_nt256")] - w[(2, "nbo")])
     a = advantage_growth(closed, "m", "rsmhp_nt256", 2, 24, seed=1, n_boot=2000)
     assert a.mean == pytest.approx(D.mean()) and a.n == n and a.high < 0
+    # a mean of per-run values: the jackknife over runs gives the Student-t interval
+    assert (a.low, a.high) == pytest.approx(_student_t(D.to_numpy()), rel=1e-10)
+    t_stat = D.mean() / (D.std(ddof=1) / np.sqrt(n))
+    assert a.p_value == pytest.approx(2 * sps.t.sf(abs(t_stat), n - 1), rel=1e-8, abs=1e-300)
+    assert a.boot_low < a.mean < a.boot_high
     assert a.d_lo == pytest.approx(-5.0, abs=1.5) and a.d_hi == pytest.approx(-20.0, abs=1.5)
     c = _hz3(closed, "m", "rsmhp_nt256", 2, 24, seed=1, n_boot=2000)
+    assert c.key.p_value == a.p_value  # supported: the two-sided p-value behind it
     assert (
         c.verdict
         == hz3_rule("rsmhp_nt256", 2, 24).verdict({"D_low": c.key.ci_low, "D_high": c.key.ci_high})
         == "supported"
     )
     s = summarize_closed(closed, seed=1, n_boot=500).set_index(["H", "method"])
-    assert s.loc[(24, "rsmhp_nt256"), "error_diff"] == pytest.approx(
-        (w[(24, "rsmhp_nt256")] - w[(24, "nbo")]).mean()
-    )
+    d24 = (w[(24, "rsmhp_nt256")] - w[(24, "nbo")]).to_numpy()
+    assert s.loc[(24, "rsmhp_nt256"), "error_diff"] == pytest.approx(d24.mean())
+    assert (
+        s.loc[(24, "rsmhp_nt256"), "error_diff_low"],
+        s.loc[(24, "rsmhp_nt256"), "error_diff_high"],
+    ) == pytest.approx(_student_t(d24), rel=1e-10)
     assert s.loc[(2, "nbo"), "error_diff"] == 0
     with pytest.raises(ValueError, match="no closed-loop runs of 'rsmhp_nt64' at H = 2"):
         advantage_growth(closed, "m", "rsmhp_nt64", 2, 24, seed=1, n_boot=100)
+
+
+def test_warm_start_beyond_the_base_horizon_holds_the_last_control():
+    """Oracle: the closed loop's shift_plan, which drops the applied control and repeats the
+    last one; _warm extends a shifted plan the same way (and cuts it to a shorter H)."""
+    from rsmhp.experiments.decisions_uav import BeliefState
+    from rsmhp.experiments.horizon import _warm
+    from rsmhp.uav.planner import shift_plan
+
+    plan = np.array([[0.1, -0.2], [0.3, 0.4], [-0.5, 0.6]])
+    st = BeliefState("m", 0, 1, np.zeros(4), np.zeros(4), np.eye(4), shift_plan(plan))
+    long = _warm(st, 7)
+    assert long.shape == (7, 2)
+    np.testing.assert_array_equal(long[:3], st.warm)
+    np.testing.assert_array_equal(long[3:], np.tile(plan[-1], (4, 1)))  # the last control held
+    # one step beyond: what the closed loop's next shift would give
+    np.testing.assert_array_equal(_warm(st, 4), np.vstack([st.warm, shift_plan(st.warm)[-1:]]))
+    np.testing.assert_array_equal(_warm(st, 2), st.warm[:2])
+    np.testing.assert_array_equal(_warm(st, 3), st.warm)
+    assert not np.shares_memory(_warm(st, 2), st.warm)
+
+
+def test_the_p_value_behind_each_verdict():
+    """The key number's p_value (the report's Holm correction reads it): the two-sided t-test
+    of 0 for a decisive verdict; for an inconclusive one the doubled one-sided p-value towards
+    the claimed side, 1 when the estimate lies on the other side (as for the FR claims)."""
+    from rsmhp.claims.horizon import _verdict_p
+
+    est, se, df = 0.3, 0.2, 9
+    two_sided = 2 * sps.t.sf(abs(est) / se, df)
+    assert _verdict_p("supported", est, se, df, "above") == pytest.approx(two_sided)
+    assert _verdict_p("not supported", -est, se, df, "above") == pytest.approx(two_sided)
+    assert _verdict_p("inconclusive", est, se, df, "above") == pytest.approx(two_sided)
+    assert _verdict_p("inconclusive", est, se, df, "below") == 1.0

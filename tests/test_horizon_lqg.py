@@ -198,10 +198,20 @@ def test_hz4_runs_from_the_first_pruned_horizon(est):
 
 
 def test_runs_to_resolve_and_the_closed_loop_summary():
-    assert runs_to_resolve(1.0, 1.0) == math.ceil(1.96**2)
-    assert runs_to_resolve(-0.5, 2.0) == math.ceil((1.96 * 4) ** 2)
+    """Runs needed = the paired t-test's sample size for 80% power at the observed effect
+    (rsmhp.stats.runs_for_power), larger than (1.96 SD / |d|)², which gives about 50% power."""
+    from rsmhp.stats import runs_for_power, t_power
+
+    for d, sd in ((1.0, 1.0), (-0.5, 2.0), (0.3, 1.7)):
+        n = runs_to_resolve(d, sd)
+        assert n == runs_for_power(sd, d, level=0.95, power=0.8)
+        assert n > math.ceil((1.96 * sd / abs(d)) ** 2)
+        assert t_power(int(n), sd, d) >= 0.8 > t_power(int(n) - 1, sd, d)
+        # the old count gives about half the power
+        assert t_power(max(2, math.ceil((1.96 * sd / abs(d)) ** 2)), sd, d) < 0.55
     assert runs_to_resolve(10.0, 0.1) == 2
     assert math.isnan(runs_to_resolve(0.0, 1.0)) and math.isnan(runs_to_resolve(1.0, np.nan))
+    assert runs_to_resolve(1e-6, 1.0) == math.inf  # beyond 10⁶ runs
     rng = np.random.default_rng(2)
     rows = []
     for method, shift in (("nbo", 0.0), ("rsmhp_nt16", -1.0)):

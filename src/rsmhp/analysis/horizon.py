@@ -11,22 +11,29 @@ standard error :math:`s` of its reference,
   so :math:`E[e^2] = \mathrm{MSE} + \mathrm{Var}(\hat J_{ref})/J^2`: subtracting the
   reference's variance leaves the method's own error), both over plans and replicates;
 * ``rel_bias`` = mean of b over states, ``rel_rmse`` = :math:`\sqrt{\max(\overline q, 0)}`,
-  each with a 95% percentile-bootstrap CI that resamples *runs* (clusters: the belief states
-  of one run share its scenario, so they are not independent) and keeps all their states;
+  each with a 95% cluster-t CI over *runs* (clusters: the belief states of one run share its
+  scenario, so they are not independent): the jackknife that leaves out one run with all its
+  states at a time, t with runs − 1 df (:func:`rsmhp.stats.cluster_t_ci`; it holds with
+  few runs, where a percentile bootstrap over them is too narrow). The RMSE's CI is that of
+  the mean square :math:`\overline q` mapped through :math:`\sqrt{\max(\cdot, 0)}` (monotone,
+  so the coverage carries over; 0 where the mean square's CI reaches below 0);
   ``ref_noise`` = :math:`\sqrt{\overline{s^2}}`, the reference's own relative SE; ``spearman``
   = mean over (state, replicate) of the rank correlation of estimate and reference over the
   plans (undefined where the estimate is constant over them, e.g. NBO's single hypothesis
   outside every plan's footprint: counted in ``spearman_undefined``).
 
-:func:`rmse_growth` is the paired change of ``rel_rmse`` between two horizons, resampling the
-same runs (with their belief states) at both. Regret and time per (model, H, method): mean
-relative regret against the best plan found and against the best of the methods' plans, and
-the median planning milliseconds.
+:func:`rmse_growth` is the paired change of ``rel_rmse`` between two horizons over the same
+runs (with their belief states) at both, with the cluster-t CI (jackknife over runs) and, beside
+it, the percentile-bootstrap CI over runs it replaces (``boot_low``, ``boot_high``), so that a
+report can show how the interval and the verdicts it gives changed. :func:`advantage_growth`
+(closed loop, HZ-3) likewise; for its mean of per-run values the jackknife interval is the
+Student-t interval. Regret and time per (model, H, method): mean relative regret against the
+best plan found and against the best of the methods' own plans (which mixes the cost
+approximation's error with the optimiser's), and the median planning milliseconds.
 """
 
 from __future__ import annotations
 
-import math
 from typing import NamedTuple
 
 import numpy as np
@@ -35,10 +42,13 @@ from scipy import stats as sps
 
 from rsmhp import lqg, lqg_horizon
 from rsmhp.seeding import job_rng
+from rsmhp.stats import ClusterInterval, cluster_t_ci, runs_for_power
 
 __all__ = [
     "APPROX_SUMMARY_COLUMNS",
     "CLOSED_SUMMARY_COLUMNS",
+    "LEVEL",
+    "POWER",
     "REGRET_SUMMARY_COLUMNS",
     "Advantage",
     "Growth",
@@ -82,6 +92,14 @@ REGRET_SUMMARY_COLUMNS = [
 
 _STATE = ["run", "step"]
 
+#: confidence level of every CI of this module
+LEVEL = 0.95
+#: power of the paired t-test at which :func:`runs_to_resolve` counts the runs a confirmatory
+#: comparison needs
+POWER = 0.8
+#: the largest run count :func:`runs_to_resolve` searches (beyond it: inf)
+_MAX_RUNS = 10**6
+
 
 def state_errors(approx: pd.DataFrame) -> pd.DataFrame:
     """Per (model, H, method, run, step): ``b`` (mean relative error), ``q`` (noise-corrected
@@ -96,16 +114,13 @@ def state_errors(approx: pd.DataFrame) -> pd.DataFrame:
     ]
 
 
-def _cluster_means(
-    x: np.ndarray, runs: np.ndarray, rng: np.random.Generator, n_boot: int
-) -> np.ndarray:
-    """Bootstrap means of per-state values ``x`` resampling runs (clusters) with all their
-    states: ``n_boot`` values of sum(x over drawn runs) / (states of drawn runs)."""
+def _cluster_mean_ci(x: np.ndarray, runs: np.ndarray) -> ClusterInterval:
+    """Cluster-t CI (jackknife over runs) of the mean of per-state values ``x`` over all
+    states: sum(x over the kept runs) / (states of the kept runs)."""
     ids, inv = np.unique(runs, return_inverse=True)
     sums = np.bincount(inv, weights=x, minlength=ids.size)
     counts = np.bincount(inv, minlength=ids.size).astype(float)
-    idx = rng.integers(0, ids.size, size=(n_boot, ids.size))
-    return sums[idx].sum(axis=1) / counts[idx].sum(axis=1)
+    return cluster_t_ci(lambda idx: float(sums[idx].sum() / counts[idx].sum()), ids.size, LEVEL)
 
 
 def _spearman(g: pd.DataFrame) -> float:
@@ -115,8 +130,12 @@ def _spearman(g: pd.DataFrame) -> float:
     return float(sps.spearmanr(est, ref).statistic)
 
 
-def summarize_approx(approx: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFrame:
-    """One row per (model, H, method) of ``approx`` (module docstring), in table order."""
+def summarize_approx(
+    approx: pd.DataFrame, seed: int | None = None, n_boot: int | None = None
+) -> pd.DataFrame:
+    """One row per (model, H, method) of ``approx`` (module docstring), in table order; CIs
+    cluster-t over runs (NaN with fewer than 2 runs). ``seed`` and ``n_boot`` are unused
+    (the CIs no longer resample) and kept for the callers."""
     per_state = state_errors(approx)
     rho = (
         approx.groupby(["model", "H", "method", *_STATE, "replicate"], sort=False)
@@ -133,14 +152,9 @@ def summarize_approx(approx: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFra
         runs = g["run"].to_numpy()
         r = rho[(rho["model"] == model) & (rho["H"] == H) & (rho["method"] == method)]["rho"]
         if np.unique(runs).size >= 2:
-            bb = _cluster_means(b, runs, job_rng(seed, "horizon_bias", **key), n_boot)
-            b_lo, b_hi = (float(v) for v in np.quantile(bb, [0.025, 0.975]))
-            qb = np.sqrt(
-                np.maximum(
-                    _cluster_means(q, runs, job_rng(seed, "horizon_rmse", **key), n_boot), 0.0
-                )
-            )
-            q_lo, q_hi = (float(v) for v in np.quantile(qb, [0.025, 0.975]))
+            cb, cq = _cluster_mean_ci(b, runs), _cluster_mean_ci(q, runs)
+            b_lo, b_hi = cb.low, cb.high
+            q_lo, q_hi = (float(np.sqrt(max(v, 0.0))) for v in (cq.low, cq.high))
         else:
             b_lo = b_hi = q_lo = q_hi = float("nan")
         rows.append(
@@ -164,8 +178,11 @@ def summarize_approx(approx: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFra
 
 class Growth(NamedTuple):
     """Change of the relative RMSE between two horizons (``h_lo`` -> ``h_hi``), paired over
-    ``n`` belief states (bootstrap over their runs), with its 95% CI; ``lo_value`` and
-    ``hi_value`` the RMSEs."""
+    ``n`` belief states of ``runs`` runs, with its 95% cluster-t CI ``[low, high]``
+    (jackknife over runs: standard error ``se``, t with ``df`` = runs − 1 degrees of freedom)
+    and ``p_value``, the two-sided t-test p-value of g = 0; ``lo_value`` and ``hi_value`` the
+    RMSEs; ``[boot_low, boot_high]`` the 95% percentile-bootstrap CI over runs (the former
+    published interval, kept for comparison)."""
 
     mean: float
     low: float
@@ -175,6 +192,12 @@ class Growth(NamedTuple):
     hi_value: float
     h_lo: int
     h_hi: int
+    runs: int
+    se: float
+    df: int
+    p_value: float
+    boot_low: float
+    boot_high: float
 
 
 def _q_wide(per: pd.DataFrame, model: str, method: str, hs: tuple[int, int]) -> pd.DataFrame:
@@ -204,11 +227,16 @@ def rmse_growth(
     minus: str | None = None,
 ) -> Growth:
     r""":math:`g = \mathrm{RMSE}_{rel}(H_{hi}) - \mathrm{RMSE}_{rel}(H_{lo})` of ``method``
-    on ``model``, resampling runs (with all their belief states) jointly at both horizons (the
-    same states); with
-    ``minus`` another method, :math:`g_{method} - g_{minus}` on jointly resampled states
-    (``lo_value``/``hi_value`` are then ``method``'s RMSEs). ValueError if a horizon lacks a
-    method or fewer than 2 states are shared."""
+    on ``model`` over the belief states both horizons share; with ``minus`` another method,
+    :math:`g_{method} - g_{minus}` on the same states (``lo_value``/``hi_value`` are then
+    ``method``'s RMSEs).
+
+    The CI is the cluster-t interval (:func:`rsmhp.stats.cluster_t_ci`): g is recomputed
+    leaving out one run at a time with all its belief states, at both horizons (and for both
+    methods) together, and :math:`g \pm t_{R-1}\,\mathrm{se}_{jack}` over the R runs; the
+    percentile-bootstrap CI resamples the same runs jointly (``n_boot`` draws, stream keyed on
+    model, method, minus, h_lo, h_hi). ValueError if a horizon lacks a method, fewer than 2
+    states are shared or they come from fewer than 2 runs."""
     per = state_errors(approx)
     hs = (int(h_lo), int(h_hi))
     parts = [_q_wide(per, model, method, hs)]
@@ -244,12 +272,16 @@ def rmse_growth(
             out = out - (rm(sums[1][1]) - rm(sums[1][0]))
         return out
 
+    ci = cluster_t_ci(lambda idx: float(g(idx)), ids.size, LEVEL)
     key = {"model": model, "method": method, "minus": minus or "", "h_lo": hs[0], "h_hi": hs[1]}
     rng = job_rng(seed, "horizon_growth", **key)
     boots = g(rng.integers(0, ids.size, size=(n_boot, ids.size)))
-    c_lo, c_hi = np.quantile(boots, [0.025, 0.975])
+    c_lo, c_hi = np.quantile(boots, [0.5 - LEVEL / 2, 0.5 + LEVEL / 2])
     a, b = float(_rmse(q[0][0])), float(_rmse(q[0][1]))
-    return Growth(float(g(np.arange(ids.size))), float(c_lo), float(c_hi), len(wide), a, b, *hs)
+    return Growth(
+        ci.estimate, ci.low, ci.high, len(wide), a, b, *hs, runs=int(ids.size), se=ci.se,
+        df=ci.df, p_value=ci.p_value(0.0), boot_low=float(c_lo), boot_high=float(c_hi),
+    )  # fmt: skip
 
 
 def summarize_horizon_regret(regret: pd.DataFrame) -> pd.DataFrame:
@@ -311,12 +343,16 @@ def _paired(model: str, closed: pd.DataFrame) -> pd.DataFrame:
     return g.pivot_table(index="run", columns=["H", "method"], values="mean_error")
 
 
-def summarize_closed(closed: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFrame:
+def summarize_closed(
+    closed: pd.DataFrame, seed: int | None = None, n_boot: int | None = None
+) -> pd.DataFrame:
     """Per (model, H, method), over the runs that pair with NBO's: their number, the mean
-    location error (m), the paired difference method − NBO with its 95% percentile-bootstrap
-    CI (stream keyed on model, H, method; NaN with fewer than 2 pairs), the SD of the paired
-    differences over runs, the runs a CI would need to exclude 0 if the mean difference
-    stayed as it is (:func:`runs_to_resolve`) and the median planning ms per step."""
+    location error (m), the paired difference method − NBO with its 95% cluster-t CI over
+    runs (for this mean of per-run differences the jackknife gives the Student-t interval;
+    NaN with fewer than 2 pairs), the SD of the paired differences over runs, the runs a
+    confirmatory comparison would need to detect a difference of the observed size with 80%
+    power (:func:`runs_to_resolve`) and the median planning ms per step. ``seed`` and
+    ``n_boot`` are unused (the CI no longer resamples) and kept for the callers."""
     base = _baseline_name()
     rows = []
     for (model, H, method, family), g in closed.groupby(
@@ -330,9 +366,8 @@ def summarize_closed(closed: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFra
         if method == base:
             lo = hi = 0.0
         elif d.size >= 2:
-            rng = job_rng(seed, "horizon_closed", **key)
-            idx = rng.integers(0, d.size, size=(n_boot, d.size))
-            lo, hi = (float(v) for v in np.quantile(d[idx].mean(axis=1), [0.025, 0.975]))
+            ci = _mean_ci(d)
+            lo, hi = ci.low, ci.high
         else:
             lo = hi = float("nan")
         rows.append(
@@ -355,20 +390,39 @@ def summarize_closed(closed: pd.DataFrame, seed: int, n_boot: int) -> pd.DataFra
 
 
 def runs_to_resolve(mean: float, sd: float) -> float:
-    r""":math:`\lceil (1.96\, s / |\bar d|)^2 \rceil`: the paired runs at which a normal 95%
-    CI of half-width :math:`1.96 s/\sqrt n` would just exclude 0 around a mean difference
-    :math:`\bar d` with SD :math:`s` over runs (the sample size a comparison needs to resolve
-    the difference it measured; NaN for :math:`\bar d = 0` or a NaN input; at least 2)."""
+    r"""The paired runs a confirmatory comparison needs to detect a mean difference of the
+    observed size :math:`\bar d` with 80% power (:data:`POWER`): the smallest n at which the
+    two-sided paired t-test at level 5% rejects :math:`\bar d = 0` with probability 0.8 when
+    the true mean difference is :math:`\bar d` and the SD over runs is :math:`s`
+    (:func:`rsmhp.stats.runs_for_power`, noncentral t; at least 2).
+
+    The observed difference is taken as the true effect: where it is inflated (a selected or
+    lucky comparison, the winner's curse) the count is optimistic. It replaces
+    :math:`(1.96\, s/|\bar d|)^2`, the n at which a normal CI around :math:`\bar d` would
+    just exclude 0, which gives only 50% power. NaN for :math:`\bar d = 0` or a NaN input;
+    inf if even 10⁶ runs do not give the power."""
     if not (np.isfinite(mean) and np.isfinite(sd)) or mean == 0.0:
         return float("nan")
-    return float(max(2, math.ceil((1.96 * sd / abs(mean)) ** 2)))
+    try:
+        return float(runs_for_power(sd, mean, level=LEVEL, power=POWER, max_n=_MAX_RUNS))
+    except ValueError:
+        return float("inf")
+
+
+def _mean_ci(x: np.ndarray) -> ClusterInterval:
+    """Cluster-t CI of the mean of per-run values ``x`` (the Student-t interval)."""
+    return cluster_t_ci(lambda idx: float(x[idx].mean()), x.size, LEVEL)
 
 
 class Advantage(NamedTuple):
     """Change of the closed-loop advantage d(H) = error(method) − error(NBO) from ``h_lo``
     to ``h_hi`` (m; negative: the advantage grows), paired over ``n`` runs, with its 95%
-    bootstrap CI, the two mean advantages ``d_lo``, ``d_hi`` and the SD of the paired change
-    over runs (a CI half-width w needs about (1.96 sd / w)² runs)."""
+    cluster-t CI ``[low, high]`` (jackknife over runs; for this mean of per-run changes the
+    Student-t interval, standard error ``se``, ``df`` = n − 1) and ``p_value``, the
+    two-sided t-test p-value of D = 0; the two mean advantages ``d_lo``, ``d_hi``; the SD of
+    the paired change over runs; ``runs_needed``, the runs a confirmatory comparison needs
+    for 80% power at the observed D (:func:`runs_to_resolve`); ``[boot_low, boot_high]``
+    the 95% percentile-bootstrap CI over runs (the former published interval)."""
 
     mean: float
     low: float
@@ -377,14 +431,23 @@ class Advantage(NamedTuple):
     d_lo: float
     d_hi: float
     sd: float
+    se: float
+    df: int
+    p_value: float
+    runs_needed: float
+    boot_low: float
+    boot_high: float
 
 
 def advantage_growth(
     closed: pd.DataFrame, model: str, method: str, h_lo: int, h_hi: int, seed: int, n_boot: int
 ) -> Advantage:
     r""":math:`D = \overline{d_r(H_{hi}) - d_r(H_{lo})}` with :math:`d_r(H)` = mean error of
-    ``method`` − NBO's in run r at horizon H (the same scenario at both H); 95% bootstrap CI
-    over runs. ValueError if a horizon or method is missing or fewer than 2 runs pair."""
+    ``method`` − NBO's in run r at horizon H (the same scenario at both H); 95% cluster-t CI
+    over runs (the Student-t interval of the mean of the per-run changes) with its t-test
+    p-value, and the 95% percentile-bootstrap CI over runs beside it (``n_boot`` draws, stream
+    keyed on model, method, h_lo, h_hi). ValueError if a horizon or method is missing or
+    fewer than 2 runs pair."""
     base = _baseline_name()
     w = _paired(model, closed)
     for h in (h_lo, h_hi):
@@ -397,12 +460,15 @@ def advantage_growth(
     D = (d_hi - d_lo).to_numpy(float)
     if D.size < 2:
         raise ValueError(f"{method!r} on {model!r}: {D.size} paired run(s)")
+    ci = _mean_ci(D)
     rng = job_rng(seed, "horizon_advantage", model=model, method=method, h_lo=h_lo, h_hi=h_hi)
     idx = rng.integers(0, D.size, size=(n_boot, D.size))
-    lo, hi = np.quantile(D[idx].mean(axis=1), [0.025, 0.975])
+    lo, hi = np.quantile(D[idx].mean(axis=1), [0.5 - LEVEL / 2, 0.5 + LEVEL / 2])
+    sd = float(D.std(ddof=1))
     return Advantage(
-        float(D.mean()), float(lo), float(hi), int(D.size), float(d_lo.mean()),
-        float(d_hi.mean()), float(D.std(ddof=1)),
+        ci.estimate, ci.low, ci.high, int(D.size), float(d_lo.mean()), float(d_hi.mean()), sd,
+        se=ci.se, df=ci.df, p_value=ci.p_value(0.0), runs_needed=runs_to_resolve(ci.estimate, sd),
+        boot_low=float(lo), boot_high=float(hi),
     )  # fmt: skip
 
 

@@ -6,17 +6,28 @@ horizons of ``horizon.uav.H``.
 
 * **HZ-1** (:func:`hz1_rule`): g = relative RMSE of NBO's cost estimate at H_hi − at H_lo
   (:func:`rsmhp.analysis.horizon.rmse_growth`, the same belief states at both). NBO's cost
-  approximation error grows with H: *supported* if the 95% bootstrap CI of g lies above 0,
-  *not supported* below 0, *inconclusive* otherwise.
+  approximation error grows with H: *supported* if the 95% cluster-t CI of g (jackknife over
+  runs, t with runs − 1 df) lies above 0, *not supported* below 0, *inconclusive* otherwise.
 * **HZ-3** (:func:`hz3_rule`, one model: ``horizon.uav.claims.closed_model``): D = (closed-loop
   mean error of the Monte-Carlo member − NBO's at H_hi) − (the same at H_lo), paired over
   runs (the same scenarios at both H; m). The advantage of sampling over NBO grows with H:
-  *supported* if the CI of D lies below 0, *not supported* above 0, *inconclusive* otherwise.
+  *supported* if the 95% Student-t CI of D over runs lies below 0, *not supported* above 0,
+  *inconclusive* otherwise.
 * **HZ-2** (:func:`hz2_rule`): d = g(pruned tree) − g(Monte Carlo with N_T = M), the
   members fixed in ``horizon.uav.claims``, from the smallest H at which the tree is pruned
   (N^(H+1) > M leaves, so it keeps M trajectories, as many as Monte Carlo) to H_hi. The
-  pruned tree's error grows with H more than Monte Carlo's: *supported* if the CI of d lies
-  above 0, *not supported* below 0, *inconclusive* otherwise.
+  pruned tree's error grows with H more than Monte Carlo's: *supported* if the cluster-t CI
+  of d lies above 0, *not supported* below 0, *inconclusive* otherwise.
+
+The primary test of each of HZ-1..HZ-3 is the t-test of 0 that its CI inverts; its p-value,
+for the report's Holm correction over the FR and HZ claims
+(:func:`rsmhp.verdicts.holm_correct`), is the key number's ``p_value``:
+:func:`rsmhp.verdicts.decisive_p` of the verdict, i.e. the two-sided t-test p-value of 0 for
+``supported`` and ``not supported`` (below 0.05 exactly when the CI excludes 0), and for
+``inconclusive`` the doubled one-sided p-value towards the claimed side (1 when the estimate
+lies on the other side). It is also printed in the claim's ``measured`` text, next to the
+percentile-bootstrap CI over runs that the cluster-t CI replaced and the verdict that
+bootstrap CI would give (:func:`horizon_evidence`).
 
 Oven LQG (:func:`lqg_horizon_claims`; exact oracle, ``horizon.lqg``):
 
@@ -33,8 +44,9 @@ Oven LQG (:func:`lqg_horizon_claims`; exact oracle, ``horizon.lqg``):
 
 from __future__ import annotations
 
+import math
 from collections.abc import Mapping
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
@@ -47,12 +59,14 @@ from rsmhp.ledger import Claim, KeyNumber
 from rsmhp.markdown import fmt, fmt_ci
 from rsmhp.palette import method_label
 from rsmhp.uav import methods as registry
-from rsmhp.verdicts import Case, Rule, ci_side
+from rsmhp.verdicts import Case, Rule, ci_side, decisive_p
 
 __all__ = [
     "HZ5_RULE",
     "KEY",
+    "Evidence",
     "horizon_claims",
+    "horizon_evidence",
     "hz1_rule",
     "hz2_rule",
     "hz3_rule",
@@ -62,9 +76,57 @@ __all__ = [
 
 KEY = "g"
 
+#: how the HZ-1/HZ-2 CIs are computed (rule texts)
+_CLUSTER_T = "95% cluster-t CI: jackknife over runs, t with runs − 1 df"
+
+
+class Evidence(NamedTuple):
+    """A claim of HZ-1..HZ-3 with its primary test: ``p_value``, the claim's
+    ``key.p_value`` (the t-test of 0 behind the verdict with ``df`` degrees of freedom,
+    :func:`_verdict_p`); ``[boot_low, boot_high]``, the 95% percentile-bootstrap CI over runs
+    in the key number's unit (the interval the cluster-t CI replaced) and ``boot_verdict``,
+    the verdict the claim's rule gives on it."""
+
+    claim: Claim
+    p_value: float
+    df: int
+    boot_low: float
+    boot_high: float
+    boot_verdict: str
+
 
 def _facts(g: Growth) -> dict[str, float]:
     return {f"{KEY}_low": g.low, f"{KEY}_high": g.high}
+
+
+def _boot_facts(g: Growth) -> dict[str, float]:
+    return {f"{KEY}_low": g.boot_low, f"{KEY}_high": g.boot_high}
+
+
+def _verdict_p(verdict: str, estimate: float, se: float, df: int, claimed: str) -> float:
+    """The p-value behind a verdict of the CI rule "above (or below, ``claimed``) 0"
+    (:func:`rsmhp.verdicts.decisive_p`): the two-sided t-test p-value of 0 for ``supported``
+    and ``not supported``; for ``inconclusive`` the claimed side's (1 if the estimate lies on
+    the other)."""
+    other = "below" if claimed == "above" else "above"
+    side = other if verdict == "not supported" else claimed
+    return decisive_p(verdict, estimate, se, df, [(0.0, side)])
+
+
+def _test_text(
+    p: float, df: int, boot_low: float, boot_high: float, digits: int, unit: str, verdict: str
+) -> str:
+    """The primary test's p-value and the former bootstrap CI with its verdict (measured)."""
+    return (
+        f"t-test of 0 behind the verdict: p = {fmt(p, 3)} ({df} df, before Holm's correction); "
+        f"the 95% percentile bootstrap over runs gives {fmt_ci(boot_low, boot_high, digits, True)}"
+        f" {unit} (verdict by it: {verdict})"
+    )
+
+
+def _runs_needed_text(runs: float) -> str:
+    """A run count of :func:`rsmhp.analysis.horizon.runs_to_resolve` in words."""
+    return f"{int(runs)}" if math.isfinite(runs) else "more than 10⁶"
 
 
 def hz1_rule(h_lo: int, h_hi: int) -> Rule:
@@ -74,7 +136,7 @@ def hz1_rule(h_lo: int, h_hi: int) -> Rule:
         0.0,
         claimed="above",
         basis=f"g = relative RMSE of NBO's cost estimate at H = {h_hi} − at H = {h_lo}, the same "
-        "belief states (bootstrap over runs)",
+        f"belief states ({_CLUSTER_T})",
     )
 
 
@@ -85,7 +147,7 @@ def hz2_rule(tree: str, mc: str, h_lo: int, h_hi: int) -> Rule:
         0.0,
         claimed="above",
         basis=f"g = growth of the relative RMSE from H = {h_lo} to {h_hi} of "
-        f"{method_label(tree)} − that of {method_label(mc)} (bootstrap over runs)",
+        f"{method_label(tree)} − that of {method_label(mc)} ({_CLUSTER_T})",
     )
 
 
@@ -96,16 +158,24 @@ def hz3_rule(mc: str, h_lo: int, h_hi: int) -> Rule:
         0.0,
         claimed="below",
         basis=f"D = (mean error of {method_label(mc)} − NBO at H = {h_hi}) − (the same at "
-        f"H = {h_lo}), paired over runs (m)",
+        f"H = {h_lo}), paired over runs (m; 95% Student-t CI over runs)",
     )
 
 
 def _hz3(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: int,
          n_boot: int) -> Claim:  # fmt: skip
+    return _hz3_evidence(closed, model, mc, h_lo, h_hi, seed, n_boot).claim
+
+
+def _hz3_evidence(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: int,
+                  n_boot: int) -> Evidence:  # fmt: skip
     a: Advantage = advantage_growth(closed, model, mc, h_lo, h_hi, seed, n_boot)
     rule = hz3_rule(mc, h_lo, h_hi)
     half = (a.high - a.low) / 2
-    return Claim(
+    verdict = rule.verdict({"D_low": a.low, "D_high": a.high})
+    p = _verdict_p(verdict, a.mean, a.se, a.df, "below")
+    boot_verdict = rule.verdict({"D_low": a.boot_low, "D_high": a.boot_high})
+    claim = Claim(
         f"HZ-3-{model}",
         f"On '{model}', the closed-loop advantage of {method_label(mc)} over NBO grows with "
         f"the horizon (H = {h_lo} to {h_hi})",
@@ -120,20 +190,24 @@ def _hz3(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: 
             reproducible="statistical",
             digits=3,
             null=0.0,
+            p_value=p,
         ),
-        rule.verdict({"D_low": a.low, "D_high": a.high}),
+        verdict,
         rule.text(),
         measured=f"{a.n} paired runs; {method_label(mc)} − NBO mean error "
         f"{fmt(a.d_lo, 3, True)} m at H = {h_lo}, {fmt(a.d_hi, 3, True)} m at H = {h_hi}; "
-        f"CI half-width {fmt(half, 2)} m from {a.n} runs (SD of the paired change "
-        f"{fmt(a.sd, 3)} m: a half-width of {fmt(half / 2, 2)} m would need about "
-        f"{4 * a.n} runs)",
+        f"CI half-width {fmt(half, 2)} m (SD of the paired change {fmt(a.sd, 3)} m); "
+        + _test_text(p, a.df, a.boot_low, a.boot_high, 3, "m", boot_verdict)
+        + f"; a confirmatory run would need {_runs_needed_text(a.runs_needed)} paired runs to "
+        "detect a D of the observed size with 80% power (paired t-test at 5%; the observed D is "
+        "taken as the true effect, which is optimistic if selection inflated it)",
         part="beyond",
         setup=f"UAV '{model}', closed loop, H = {h_lo} and {h_hi}",
     )
+    return Evidence(claim, p, a.df, a.boot_low, a.boot_high, boot_verdict)
 
 
-def _key(name: str, g: Growth) -> KeyNumber:
+def _key(name: str, g: Growth, p_value: float) -> KeyNumber:
     return KeyNumber(
         name,
         100 * g.mean,
@@ -143,11 +217,16 @@ def _key(name: str, g: Growth) -> KeyNumber:
         reproducible="statistical",
         digits=2,
         null=0.0,
+        p_value=p_value,
     )
 
 
 def _pct(g: Growth) -> Growth:
-    return g._replace(mean=100 * g.mean, low=100 * g.low, high=100 * g.high)
+    """``g`` with its estimate and both CIs in percentage points."""
+    return g._replace(
+        mean=100 * g.mean, low=100 * g.low, high=100 * g.high, boot_low=100 * g.boot_low,
+        boot_high=100 * g.boot_high,
+    )  # fmt: skip
 
 
 def horizon_claims(
@@ -161,6 +240,18 @@ def horizon_claims(
     ``approx``: the cost-approximation rows of every (model, H); ``summary``:
     :func:`rsmhp.analysis.horizon.summarize_approx`; ``cfg``: ``horizon.uav``; ``closed``:
     the closed-loop rows (:data:`rsmhp.experiments.horizon.CLOSED_COLUMNS`)."""
+    return [e.claim for e in horizon_evidence(approx, summary, cfg, seed, closed)]
+
+
+def horizon_evidence(
+    approx: pd.DataFrame,
+    summary: pd.DataFrame,
+    cfg: Mapping[str, Any],
+    seed: int,
+    closed: pd.DataFrame | None = None,
+) -> list[Evidence]:
+    """The claims of :func:`horizon_claims` (same arguments), each with its primary test's
+    p-value and the percentile-bootstrap CI it replaced (:class:`Evidence`)."""
     if summary.empty:
         return []
     hs = sorted(int(h) for h in summary["H"].unique())
@@ -171,7 +262,7 @@ def horizon_claims(
     rules = cfg.get("claims", {}) or {}
     tree, mc = rules.get("tree"), rules.get("monte_carlo")
     tree_lo = _pruned_from(tree, hs) if tree else None
-    out: list[Claim] = []
+    out: list[Evidence] = []
     for model in dict.fromkeys(summary["model"]):
         s = summary[summary["model"] == model]
         present = set(s["method"])
@@ -181,51 +272,61 @@ def horizon_claims(
             g = rmse_growth(approx, model, base, h_lo, h_hi, seed, n_boot)
             rule = hz1_rule(h_lo, h_hi)
             p = _pct(g)
-            out.append(
-                Claim(
-                    f"HZ-1-{model}",
-                    f"On '{model}', NBO's cost-approximation error grows with the horizon "
-                    f"(relative RMSE at H = {h_hi} above H = {h_lo})",
-                    src + "Sec. II says NBO ignores the uncertainty of the state evolution, "
-                    "which accumulates over the horizon",
-                    _key(f"NBO relative RMSE, H = {h_hi} − H = {h_lo}", g),
-                    rule.verdict(_facts(g)),
-                    rule.text(),
-                    measured=f"{g.n} belief states; relative RMSE {fmt(100 * g.lo_value, 3)}% "
-                    f"at H = {h_lo}, {fmt(100 * g.hi_value, 3)}% at H = {h_hi}; difference "
-                    f"{fmt(p.mean, 3, True)} pp {fmt_ci(p.low, p.high, 3, True)}",
-                    part="beyond",
-                    setup=setup,
-                )
+            verdict = rule.verdict(_facts(g))
+            p_value = _verdict_p(verdict, g.mean, g.se, g.df, "above")
+            boot_verdict = rule.verdict(_boot_facts(g))
+            claim = Claim(
+                f"HZ-1-{model}",
+                f"On '{model}', NBO's cost-approximation error grows with the horizon "
+                f"(relative RMSE at H = {h_hi} above H = {h_lo})",
+                src + "Sec. II says NBO ignores the uncertainty of the state evolution, "
+                "which accumulates over the horizon",
+                _key(f"NBO relative RMSE, H = {h_hi} − H = {h_lo}", g, p_value),
+                verdict,
+                rule.text(),
+                measured=f"{g.n} belief states of {g.runs} runs; relative RMSE "
+                f"{fmt(100 * g.lo_value, 3)}% at H = {h_lo}, {fmt(100 * g.hi_value, 3)}% at "
+                f"H = {h_hi}; difference {fmt(p.mean, 3, True)} pp "
+                f"{fmt_ci(p.low, p.high, 3, True)}; "
+                + _test_text(p_value, g.df, p.boot_low, p.boot_high, 3, "pp", boot_verdict),
+                part="beyond",
+                setup=setup,
             )
+            out.append(Evidence(claim, p_value, g.df, p.boot_low, p.boot_high, boot_verdict))
         if tree and mc and {tree, mc} <= present and tree_lo is not None and tree_lo < h_hi:
             d = rmse_growth(approx, model, tree, tree_lo, h_hi, seed, n_boot, minus=mc)
             g_mc = rmse_growth(approx, model, mc, tree_lo, h_hi, seed, n_boot)
             rule = hz2_rule(tree, mc, tree_lo, h_hi)
-            out.append(
-                Claim(
-                    f"HZ-2-{model}",
-                    f"On '{model}', the error of {method_label(tree)} grows with the horizon "
-                    f"more than that of {method_label(mc)} (both M trajectories, H = {tree_lo} "
-                    f"to {h_hi})",
-                    src + "Sec. II proposes pruning to keep the tree's N^H trajectories "
-                    "tractable as H grows",
-                    _key(
-                        f"RMSE growth H = {tree_lo} → {h_hi}, {method_label(tree)} − "
-                        f"{method_label(mc)}",
-                        d,
-                    ),
-                    rule.verdict(_facts(d)),
-                    rule.text(),
-                    measured=f"{d.n} belief states; relative RMSE of {method_label(tree)} "
-                    f"{fmt(100 * d.lo_value, 3)}% → {fmt(100 * d.hi_value, 3)}%, of "
-                    f"{method_label(mc)} {fmt(100 * g_mc.lo_value, 3)}% → "
-                    f"{fmt(100 * g_mc.hi_value, 3)}% (H = {tree_lo} → {h_hi}; from H = "
-                    f"{tree_lo} the tree has more than M leaves, so it is pruned)",
-                    part="beyond",
-                    setup=f"UAV '{model}', belief states of NBO runs, H = {tree_lo} to {h_hi}",
-                )
+            p = _pct(d)
+            verdict = rule.verdict(_facts(d))
+            p_value = _verdict_p(verdict, d.mean, d.se, d.df, "above")
+            boot_verdict = rule.verdict(_boot_facts(d))
+            claim = Claim(
+                f"HZ-2-{model}",
+                f"On '{model}', the error of {method_label(tree)} grows with the horizon "
+                f"more than that of {method_label(mc)} (both M trajectories, H = {tree_lo} "
+                f"to {h_hi})",
+                src + "Sec. II proposes pruning to keep the tree's N^H trajectories "
+                "tractable as H grows",
+                _key(
+                    f"RMSE growth H = {tree_lo} → {h_hi}, {method_label(tree)} − "
+                    f"{method_label(mc)}",
+                    d,
+                    p_value,
+                ),
+                verdict,
+                rule.text(),
+                measured=f"{d.n} belief states of {d.runs} runs; relative RMSE of "
+                f"{method_label(tree)} "
+                f"{fmt(100 * d.lo_value, 3)}% → {fmt(100 * d.hi_value, 3)}%, of "
+                f"{method_label(mc)} {fmt(100 * g_mc.lo_value, 3)}% → "
+                f"{fmt(100 * g_mc.hi_value, 3)}% (H = {tree_lo} → {h_hi}; from H = "
+                f"{tree_lo} the tree has more than M leaves, so it is pruned); "
+                + _test_text(p_value, d.df, p.boot_low, p.boot_high, 3, "pp", boot_verdict),
+                part="beyond",
+                setup=f"UAV '{model}', belief states of NBO runs, H = {tree_lo} to {h_hi}",
             )
+            out.append(Evidence(claim, p_value, d.df, p.boot_low, p.boot_high, boot_verdict))
     out += _hz3_claims(closed, cfg, mc, seed, n_boot)
     return out
 
@@ -240,7 +341,7 @@ def _pruned_from(tree: str, hs: list[int]) -> int | None:
 
 def _hz3_claims(
     closed: pd.DataFrame | None, cfg: Mapping[str, Any], mc: str | None, seed: int, n_boot: int
-) -> list[Claim]:
+) -> list[Evidence]:
     """HZ-3 on ``horizon.uav.claims.closed_model``, between the smallest and largest H of the
     closed-loop rows (none if either is missing)."""
     model = (cfg.get("claims", {}) or {}).get("closed_model") or ""
@@ -250,7 +351,7 @@ def _hz3_claims(
     hs = sorted(int(h) for h in sel["H"].unique())
     if len(hs) < 2 or mc not in set(sel["method"]):
         return []
-    return [_hz3(closed, model, mc, hs[0], hs[-1], seed, n_boot)]
+    return [_hz3_evidence(closed, model, mc, hs[0], hs[-1], seed, n_boot)]
 
 
 def hz4_rule(N: int, M: int, h_lo: int, h_hi: int) -> Rule:

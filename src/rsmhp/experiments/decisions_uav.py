@@ -26,9 +26,10 @@ planner's optimiser, ``uav.planner.optimiser``) of :math:`\hat J_{ev}` itself (s
 Because :math:`x_{best}` is optimised on the evaluation set, the regret is biased upwards by
 at most that optimisation's overfit, :math:`O(1/T)`.
 
-``regret_methods`` is the same difference against the best of the methods' plans only: the
-part of the regret due to the cost approximation, at the methods' common optimiser budget
-(the rest is the optimiser stopping at a poorer local minimum than the multi-start).
+``regret_methods`` is the same difference against the best of the methods' plans only, at the
+methods' common optimiser budget. It mixes approximation and optimisation error (a method's
+plan can lose to another's because its cost is a worse approximation or because the optimiser
+stopped at a poorer local minimum): nothing here separates the two.
 
 Rank agreement: ``n_random`` plans uniform in the box (and ``n_random`` local perturbations
 of the best plan, :math:`x_{best} + \mathcal N(0, 0.1^2)` clipped to the box) are costed by

@@ -151,12 +151,20 @@ def horizon_contracts(cfg: Mapping[str, Any], model: str, H: int) -> tuple[Contr
 
 
 def _warm(state: BeliefState, H: int) -> np.ndarray:
-    """The state's warm start (the shifted previous plan, base horizon) cut or padded with
-    zeros to H steps."""
-    w = np.zeros((H, 2))
-    n = min(H, len(state.warm))
-    w[:n] = state.warm[:n]
-    return w
+    """The state's warm start (NBO's shifted previous plan, at the base horizon) cut to H
+    steps, or extended to H steps by repeating its last control.
+
+    Repeating the last control is the closed loop's rule for the step a shifted plan gains
+    (:func:`rsmhp.uav.planner.shift_plan`: hold the last control). Zero controls beyond the
+    base horizon would mean straight flight at constant speed, a plan nobody would choose,
+    and give the optimiser a poor start at long horizons such as H = 24, where most of the
+    plan lies beyond the base horizon. An empty warm start gives zeros."""
+    warm = np.asarray(state.warm, dtype=float).reshape(-1, 2)
+    if len(warm) == 0:
+        return np.zeros((H, 2))
+    if len(warm) >= H:
+        return warm[:H].copy()
+    return np.vstack([warm, np.repeat(warm[-1:], H - len(warm), axis=0)])
 
 
 def _approx_rows(

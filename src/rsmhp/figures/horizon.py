@@ -1,13 +1,13 @@
 r"""The UAV horizon study: cost-approximation error, planning time and regret against H.
 
 ``hz_uav_error``: columns are model variants; top row the relative RMSE of each method's cost
-estimate (%, log scale, noise-corrected; 95% bootstrap CIs over belief states; an RMSE the
+estimate (%, log scale, noise-corrected; 95% cluster-t CIs over runs; an RMSE the
 reference's noise hides, corrected to 0, is drawn at :data:`RMSE_FLOOR_PCT`), bottom row its
 relative bias (%). ``hz_uav_time``: top row the median planning milliseconds per step
-(log scale), bottom row the open-loop regret against the best of the methods' plans (% of the
-best cost: the part of the regret due to the cost approximation). x: the horizon H (log
-scale). ``hz_uav_closed``: the closed-loop mean location error minus NBO's on the same runs
-(m, 95% bootstrap CIs over runs). One line per method in its palette colour.
+(log scale), bottom row the open-loop regret against the best of the methods' own plans (% of
+the best cost; it mixes approximation and optimisation error, which the optimiser-split study
+separates). x: the horizon H (log scale). ``hz_uav_closed``: the closed-loop mean location
+error minus NBO's on the same runs (m, 95% Student-t CIs over runs). One line per method in its palette colour.
 
 ``hz_lqg`` (oven LQG, exact oracle; one row per simulated a): left, the relative RMSE (%,
 log scale) of each cost estimator with n trajectories (the largest n of the study: Monte
