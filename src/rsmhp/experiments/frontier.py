@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import logging
 import time
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from typing import Any
 
 import pandas as pd
@@ -41,17 +41,25 @@ from rsmhp.experiments.decisions_uav import (
     merge_variant,
 )
 from rsmhp.parallel import parallel_map
+from rsmhp.protocol import Configuration
 from rsmhp.seeding import job_rng
 from rsmhp.uav import methods
 from rsmhp.uav.planner import Belief
-from rsmhp.uav.simulation import UAVSetup
+from rsmhp.uav.simulation import UAVSetup, simulate_run
 
 __all__ = [
+    "CONFIG_RUN_COLUMNS",
+    "CONFIG_TIMING_COLUMNS",
+    "DEPTH_COLUMNS",
     "FRONTIER_RUN_COLUMNS",
     "TIMING_COLUMNS",
+    "config_runs_contract",
+    "config_timing_contract",
     "frontier_contracts",
     "recording_setup",
+    "run_configurations",
     "run_frontier_model",
+    "time_configurations",
     "time_planners",
     "timing_contract",
     "variant",
@@ -75,7 +83,15 @@ FRONTIER_RUN_COLUMNS = [
     "mean_nit",
     "work_per_step",
     "converged_rate",
+    "plan_depth",
+    "max_depth",
+    "root_actions",
+    "frac_depth1",
 ]
+
+#: the tree search's depth statistics of a run (means over its planning steps; NaN for the
+#: other families): :class:`rsmhp.uav.methods.tree_search.TreeSearchPlanner` diagnostics
+DEPTH_COLUMNS = ("plan_depth", "max_depth", "root_actions", "frac_depth1")
 
 #: one row per (repeat, belief state, method) of the interleaved timing (rule
 #: ``decisions_frontier_timing``): the wall time of one plan call (ms) and its work
@@ -104,7 +120,8 @@ def frontier_contracts(cfg: Mapping[str, Any], model: str) -> tuple[Contract, Co
         text=("model", "method", "family"),
         boolean=("lost",),
         integer=("N_T", "N", "M", "run"),
-        nullable=("converged_rate",),  # NaN for a planner without an optimiser
+        # NaN for a planner without an optimiser, and for one that is not a tree search
+        nullable=("converged_rate", *DEPTH_COLUMNS),
         keys=("method", "run"),
         expected=pd.DataFrame(keys, columns=["method", "run"]),
         values={"model": model},
@@ -154,6 +171,7 @@ def run_frontier_model(
             "mean_nit": s["mean_nit"],
             "work_per_step": s["work_per_step"],
             "converged_rate": s["converged_rate"],
+            **{c: s["diagnostics"].get(c, float("nan")) for c in DEPTH_COLUMNS},
         }
         for s in summaries
     ]
@@ -230,37 +248,56 @@ def time_planners(
     model: str,
     seed: int,
 ) -> pd.DataFrame:
-    r"""Interleaved wall-clock timing of every method's plan call (:data:`TIMING_COLUMNS`).
-
-    At the belief states of NBO runs ``cfg["timing"]["runs"]`` at ``steps`` (the open-loop
-    study's states, :func:`rsmhp.experiments.decisions_uav.belief_states`), every method
-    plans once per state and repeat, **round robin**: at state s of repeat r the methods are
-    called in the table order rotated by :math:`(r \cdot S + s) \bmod M` (M methods, S
-    states), so every method takes every slot equally often and a slow drift of the machine
-    (frequency, cache, another process) is spread over all methods rather than loaded on the
-    ones that run last. Each call is timed alone with ``time.perf_counter`` on one BLAS
-    thread, with the step's own stream (the closed loop's key, so the plan is the one the
-    closed loop makes at that belief). The rule holds the machine's cores while it runs, so
-    nothing runs beside it on the reference machine (2 cores). Repeats measure the spread of
-    the time from one pass to the next; the plan and its ``work`` (model steps) are the same
-    in every repeat."""
-    uav_cfg = merge_variant(uav, variant(models, model))
-    setup = UAVSetup.from_config(uav_cfg)
+    """Interleaved timing (:func:`time_configurations`) of every method of ``cfg["methods"]``
+    at its default optimiser budget, at ``cfg["timing"]``'s belief states
+    (:data:`TIMING_COLUMNS`: ``method`` names the method)."""
     planners = methods.from_config(cfg["methods"], "decisions.frontier.methods")
-    t = cfg["timing"]
+    configs = [Configuration(m) for m in planners]
+    t = time_configurations(uav, models, model, configs, cfg["timing"], seed)
+    return t.rename(columns={"config": "method"})[TIMING_COLUMNS]
+
+
+#: one row per (repeat, belief state, configuration) of :func:`time_configurations`
+CONFIG_TIMING_COLUMNS = ["model", "config", "repeat", "run", "step", "slot", "ms", "work"]
+
+
+def time_configurations(
+    uav: Mapping[str, Any],
+    models: list[Mapping[str, Any]],
+    model: str,
+    configs: Sequence[Configuration],
+    timing: Mapping[str, Any],
+    seed: int,
+) -> pd.DataFrame:
+    r"""Interleaved wall-clock timing of every configuration's plan call
+    (:data:`CONFIG_TIMING_COLUMNS`).
+
+    At the belief states of NBO runs ``timing["runs"]`` at ``timing["steps"]`` (the open-loop
+    study's states, :func:`rsmhp.experiments.decisions_uav.belief_states`, drawn from
+    ``seed``), every configuration plans once per state and repeat, **round robin**: at state
+    s of repeat r the configurations are called in order rotated by
+    :math:`(r \cdot S + s) \bmod M` (M configurations, S states), so every configuration
+    takes every slot equally often and a slow drift of the machine (frequency, cache, another
+    process) is spread over all of them rather than loaded on the ones that run last. Each
+    call is timed alone with ``time.perf_counter`` on one BLAS thread, with the step's own
+    stream (the closed loop's key, so the plan is the one the closed loop makes at that
+    belief). The rules that call this hold the machine's cores while it runs, so nothing runs
+    beside it on the reference machine (2 cores). Repeats measure the spread of the time from
+    one pass to the next; the plan and its ``work`` (model steps) are the same in every
+    repeat."""
+    base = UAVSetup.from_config(merge_variant(uav, variant(models, model)))
     with threadpool_limits(limits=1):
-        states = belief_states(setup, model, seed, range(int(t["runs"])), t["steps"])
-        built = [(m, planners[m].planner(setup)) for m in planners]
+        states = belief_states(base, model, seed, range(int(timing["runs"])), timing["steps"])
+        built = [(c, c.method, c.method.planner(c.setup(base))) for c in configs]
         n_m, n_s = len(built), len(states)
         rows = []
-        for rep in range(int(t["repeats"])):
-            log.info("frontier timing %s: repeat %d of %d", model, rep + 1, t["repeats"])
+        for rep in range(int(timing["repeats"])):
+            log.info("timing %s: repeat %d of %d", model, rep + 1, timing["repeats"])
             for si, st in enumerate(states):
                 belief = Belief(st.uav, st.x_hat, st.P_hat)
                 shift = (rep * n_s + si) % n_m
                 for slot in range(n_m):
-                    name, planner = built[(slot + shift) % n_m]
-                    method = planners[name]
+                    config, method, planner = built[(slot + shift) % n_m]
                     rng = (
                         job_rng(seed, "uav_plan", run=st.run, step=st.step + 1, **method.job_key())
                         if method.uses_rng
@@ -272,7 +309,7 @@ def time_planners(
                     rows.append(
                         {
                             "model": model,
-                            "method": name,
+                            "config": config.name,
                             "repeat": rep,
                             "run": st.run,
                             "step": st.step,
@@ -281,4 +318,116 @@ def time_planners(
                             "work": int(res.work),
                         }
                     )
-    return pd.DataFrame(rows, columns=TIMING_COLUMNS)
+    return pd.DataFrame(rows, columns=CONFIG_TIMING_COLUMNS)
+
+
+def config_timing_contract(
+    rule: str, configs: Sequence[Configuration], timing: Mapping[str, Any], model: str
+) -> Contract:
+    """What a timing rule of the protocol writes: one row per (configuration, repeat,
+    belief state) of ``timing``."""
+    keys = [
+        (c.name, rep, run, step)
+        for rep in range(int(timing["repeats"]))
+        for run in range(int(timing["runs"]))
+        for step in sorted(set(int(k) for k in timing["steps"]))
+        for c in configs
+    ]
+    return Contract(
+        rule=rule,
+        columns=CONFIG_TIMING_COLUMNS,
+        text=("model", "config"),
+        integer=("repeat", "run", "step", "slot", "work"),
+        keys=("config", "repeat", "run", "step"),
+        expected=pd.DataFrame(keys, columns=["config", "repeat", "run", "step"]),
+        values={"model": model},
+    )
+
+
+#: one row per (configuration, run) of :func:`run_configurations`
+CONFIG_RUN_COLUMNS = [
+    "model",
+    "config",
+    "member",
+    "family",
+    "maxiter",
+    "restarts",
+    "run",
+    "mean_error",
+    "final_error",
+    "detect_rate",
+    "lost",
+    "plan_ms",
+    "mean_nit",
+    "work_per_step",
+    "converged_rate",
+    *DEPTH_COLUMNS,
+]
+
+
+def _config_task(job) -> dict[str, Any]:
+    uav_cfg, config, seed, run = job
+    setup = config.setup(UAVSetup.from_config(uav_cfg))
+    summary, _ = simulate_run(setup, config.method, seed, run)
+    return summary
+
+
+def run_configurations(
+    uav: Mapping[str, Any],
+    models: list[Mapping[str, Any]],
+    model: str,
+    configs: Sequence[Configuration],
+    runs: Sequence[int],
+    seed: int,
+    track_loss_error: float,
+) -> pd.DataFrame:
+    """Paired closed-loop runs ``runs`` of every configuration on ``model`` with root seed
+    ``seed`` (:data:`CONFIG_RUN_COLUMNS`; ``plan_ms`` is the run's planning wall time per
+    step, measured beside whatever else ran: the protocol's times come from
+    :func:`time_configurations`). One thread; runs in configuration-major order."""
+    uav_cfg = merge_variant(uav, variant(models, model))
+    setup = UAVSetup.from_config(uav_cfg)
+    jobs = [(uav_cfg, c, seed, int(r)) for c in configs for r in runs]
+    log.info("%s: %d configurations x %d closed-loop runs", model, len(configs), len(runs))
+    summaries = parallel_map(_config_task, jobs, 1, desc=f"{model} runs")
+    rows = []
+    for (_, c, _, r), s in zip(jobs, summaries, strict=True):
+        rows.append(
+            {
+                "model": model,
+                "config": c.name,
+                "member": c.member,
+                "family": c.family,
+                "maxiter": setup.planner.maxiter if c.maxiter is None else c.maxiter,
+                "restarts": c.restarts,
+                "run": r,
+                "mean_error": s["mean_error"],
+                "final_error": s["final_error"],
+                "detect_rate": s.get("detect_rate", 1.0),
+                "lost": bool(s["final_error"] > float(track_loss_error)),
+                "plan_ms": 1e3 * s["plan_seconds"] / setup.steps,
+                "mean_nit": s["mean_nit"],
+                "work_per_step": s["work_per_step"],
+                "converged_rate": s["converged_rate"],
+                **{k: s["diagnostics"].get(k, float("nan")) for k in DEPTH_COLUMNS},
+            }
+        )
+    return pd.DataFrame(rows, columns=CONFIG_RUN_COLUMNS)
+
+
+def config_runs_contract(
+    rule: str, configs: Sequence[Configuration], runs: Sequence[int], model: str
+) -> Contract:
+    """What a closed-loop rule of the protocol writes: one row per (configuration, run)."""
+    keys = [(c.name, int(r)) for c in configs for r in runs]
+    return Contract(
+        rule=rule,
+        columns=CONFIG_RUN_COLUMNS,
+        text=("model", "config", "member", "family"),
+        boolean=("lost",),
+        integer=("maxiter", "restarts", "run"),
+        nullable=("converged_rate", *DEPTH_COLUMNS),
+        keys=("config", "run"),
+        expected=pd.DataFrame(keys, columns=["config", "run"]),
+        values={"model": model},
+    )

@@ -262,6 +262,7 @@ def _simulate_run(setup, method, seed, run, observer):
     vals = np.empty((K, len(STEP_VALUES)))  # one row of floats per step, dicts built at the end
     counts = np.empty((K, 2), dtype=np.int64)  # nit, kernel calls
     work = np.empty(K, dtype=np.int64)  # model steps (PlanResult.work)
+    diagnostics: dict[str, list[float]] = {}  # PlanResult.diagnostics per step
     converged = np.full(K, np.nan)  # 1.0 / 0.0 per plan; NaN: no optimiser
     seen_k = np.ones(K, dtype=bool)
     plan_seconds = 0.0
@@ -284,6 +285,8 @@ def _simulate_run(setup, method, seed, run, observer):
         )  # fmt: skip
         counts[k - 1] = (res.nit, res.n_kernel_calls)
         work[k - 1] = res.work
+        for key, value in res.diagnostics.items():
+            diagnostics.setdefault(key, []).append(float(value))
         if res.converged is not None:
             converged[k - 1] = float(res.converged)
         if observer is not None:
@@ -316,6 +319,9 @@ def _simulate_run(setup, method, seed, run, observer):
         "plan_seconds": plan_seconds,
         "work_per_step": float(np.mean(work)),
         "converged_rate": float(np.mean(converged)),
+        # the planner's own diagnostics averaged over the steps that report them (e.g. a
+        # tree search's depth statistics)
+        "diagnostics": {key: float(np.mean(v)) for key, v in diagnostics.items()},
     }
     if limited:
         summary["detect_rate"] = int(seen_k.sum()) / K

@@ -1,0 +1,364 @@
+r"""The comparison protocol of the equal-compute study: seed streams kept apart, planner
+configurations, tuning at budgets each family fills, and the preregistration that fixes the
+confirmatory run before it is made.
+
+Streams
+-------
+Every random number of a study comes from :func:`rsmhp.seeding.job_rng` with a root seed. The
+protocol gives each purpose its own root, :func:`stream_seed`: ``exploratory`` is the config's
+``seed`` itself (the runs published up to 76a0c01, where the comparisons were chosen), ``tune``
+and ``confirm`` are derived from it by a hash, so their scenarios, noises and hypotheses share
+nothing with each other or with the exploratory runs. Tuning sees only ``tune``; the published
+verdicts come only from ``confirm``.
+
+Configurations
+--------------
+A :class:`Configuration` is a registered planning method (its member name, e.g. ``rsmhp_nt256``
+or ``dpw_s300_ka2_ko0p5_ao0``) with the optimiser budget of a sampled-cost planner: at most
+``maxiter`` iterations (``maxfun`` = 2 maxiter + 1 evaluations) and ``restarts`` further
+optimisations from fixed starts (:func:`rsmhp.uav.planner.restart_starts`). The random stream
+of a plan is the method's (its ``job_key``): the configurations of one method plan over the
+same hypotheses, so their differences are the optimiser's alone.
+
+Tuning rule (:func:`select`)
+----------------------------
+For every model, family and budget b (ms of planning wall time per step, measured by the
+interleaved timing on the tuning machine): among the family's candidates whose median time per
+step is at most b, the one with the lowest mean closed-loop location error over the tuning
+runs; ties go to the candidate with less work (model steps per step), then to the first in
+candidate order. A family with no candidate within b has no member at b. The baseline (NBO)
+is not tuned: every comparison is against the Monte-Carlo member at the same budget.
+
+Preregistration (:class:`Preregistration`)
+-----------------------------------------
+``config/preregistration.yaml``, written and committed after tuning and before the
+confirmatory run: the stream, the tuned file it copies its members from (with its SHA-256),
+the budgets, run counts with the power calculation behind them, the claims with their rules
+and margins, and the family of Holm's correction. The report and ``claims.json`` carry the
+file's SHA-256 and the commit that added it; ``make verify`` refuses a run whose
+preregistration differs from the committed one.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+import yaml
+
+from rsmhp import guards
+from rsmhp.palette import method_label
+from rsmhp.uav import methods
+from rsmhp.uav.methods.base import Method
+
+__all__ = [
+    "STREAMS",
+    "Configuration",
+    "Preregistration",
+    "candidates",
+    "file_sha256",
+    "select",
+    "stream_seed",
+]
+
+#: the seed streams of the protocol (:func:`stream_seed`)
+STREAMS = ("exploratory", "tune", "confirm")
+
+
+def stream_seed(seed: int, stream: str) -> int:
+    """The root seed of ``stream``: ``seed`` itself for ``exploratory``; for ``tune`` and
+    ``confirm`` the first 63 bits of BLAKE2b-64 of ``"<seed>/<stream>"`` (independent of
+    ``seed`` and of each other as far as any test can tell)."""
+    seed = guards.nonneg_int("seed", seed)
+    if stream not in STREAMS:
+        raise ValueError(f"stream: {stream!r} (allowed: {', '.join(STREAMS)})")
+    if stream == "exploratory":
+        return seed
+    digest = hashlib.blake2b(f"{seed}/{stream}".encode(), digest_size=8).digest()
+    return int.from_bytes(digest, "little") & (2**63 - 1)
+
+
+@dataclass(frozen=True)
+class Configuration:
+    """A planning method (``member``: a registered method's name) with its optimiser budget:
+    ``maxiter`` iterations (``None``: the ``uav.planner`` default) and ``restarts``."""
+
+    member: str
+    maxiter: int | None = None
+    restarts: int = 0
+
+    def __post_init__(self) -> None:
+        methods.from_name(self.member)  # refuses an unknown member, naming the families
+        if self.maxiter is not None:
+            object.__setattr__(self, "maxiter", guards.positive_int("maxiter", self.maxiter))
+        object.__setattr__(self, "restarts", guards.integer("restarts", self.restarts, minimum=0))
+        if not self.method.estimates_cost and (self.maxiter is not None or self.restarts):
+            raise ValueError(
+                f"configuration {self.member!r}: maxiter and restarts apply to sampled-cost "
+                f"planners only, got maxiter={self.maxiter}, restarts={self.restarts}"
+            )
+
+    @property
+    def method(self) -> Method:
+        return methods.from_name(self.member)
+
+    @property
+    def family(self) -> str:
+        return self.method.family
+
+    @property
+    def name(self) -> str:
+        """``member`` alone for the default budget, else ``member/it<maxiter>/r<restarts>``."""
+        if self.maxiter is None and self.restarts == 0:
+            return self.member
+        it = "" if self.maxiter is None else f"/it{self.maxiter}"
+        return f"{self.member}{it}/r{self.restarts}"
+
+    def label(self) -> str:
+        extra = []
+        if self.maxiter is not None:
+            extra.append(f"{self.maxiter} it")
+        if self.restarts:
+            extra.append(f"{self.restarts} restarts")
+        return method_label(self.member) + (f" ({', '.join(extra)})" if extra else "")
+
+    def setup(self, base: Any) -> Any:
+        """``base`` (a :class:`rsmhp.uav.simulation.UAVSetup`) with this optimiser budget."""
+        p = base.planner
+        maxiter = p.maxiter if self.maxiter is None else self.maxiter
+        maxfun = p.maxfun if self.maxiter is None else 2 * self.maxiter + 1
+        planner = dataclasses.replace(p, maxiter=maxiter, maxfun=maxfun, restarts=self.restarts)
+        return dataclasses.replace(base, planner=planner)
+
+    def spec(self) -> dict[str, Any]:
+        return {"member": self.member, "maxiter": self.maxiter, "restarts": self.restarts}
+
+    @classmethod
+    def from_spec(cls, spec: Mapping[str, Any]) -> Configuration:
+        unknown = set(spec) - {"member", "maxiter", "restarts"}
+        if unknown or "member" not in spec:
+            raise ValueError(
+                f"configuration {dict(spec)!r}: needs 'member', may have 'maxiter' and "
+                f"'restarts' (unknown: {sorted(unknown)})"
+            )
+        return cls(str(spec["member"]), spec.get("maxiter"), int(spec.get("restarts", 0)))
+
+
+def candidates(cfg: Mapping[str, Any]) -> list[Configuration]:
+    """The tuning candidates of ``decisions.frontier.tuning.candidates``: every member of its
+    ``methods`` block; a sampled-cost member once per (maxiter, restarts) of ``optimiser``, a
+    tree search as it is (its budget is its simulations and constants). The baseline family
+    is left out (it is not tuned). Table order, then maxiter, then restarts."""
+    block = cfg["methods"]
+    opt = cfg["optimiser"]
+    out: list[Configuration] = []
+    for m in methods.from_config(block, "decisions.frontier.tuning.candidates.methods").values():
+        if m.baseline:
+            continue
+        if m.estimates_cost:
+            out += [
+                Configuration(m.name, int(it), int(r))
+                for it in opt["maxiter"]
+                for r in opt["restarts"]
+            ]
+        else:
+            out.append(Configuration(m.name))
+    return out
+
+
+#: the columns of the tuning selection (:func:`select`)
+SELECTION_COLUMNS = [
+    "model",
+    "family",
+    "budget_ms",
+    "config",
+    "member",
+    "maxiter",
+    "restarts",
+    "plan_ms",
+    "work_per_step",
+    "mean_error",
+    "fitting",
+]
+
+
+def select(
+    quality: pd.DataFrame,
+    timing: pd.DataFrame,
+    configs: Sequence[Configuration],
+    budgets_ms: Sequence[float],
+) -> pd.DataFrame:
+    """The tuning rule of the module docstring: one row per (model, family, budget) with a
+    candidate within the budget (:data:`SELECTION_COLUMNS`; ``fitting`` = how many of the
+    family's candidates fitted). ``quality``: closed-loop rows with ``model``, ``config``,
+    ``run``, ``mean_error``, ``work_per_step``; ``timing``: rows with ``model``, ``config``,
+    ``ms`` (interleaved calls). A configuration without rows is refused, naming it."""
+    order = {c.name: i for i, c in enumerate(configs)}
+    by_name = {c.name: c for c in configs}
+    q = quality.groupby(["model", "config"], sort=False).agg(
+        mean_error=("mean_error", "mean"), work_per_step=("work_per_step", "median")
+    )
+    t = timing.groupby(["model", "config"], sort=False)["ms"].median()
+    rows = []
+    for model in dict.fromkeys(quality["model"]):
+        for c in configs:
+            for what, table in (("closed-loop", q), ("timing", t)):
+                if (model, c.name) not in table.index:
+                    raise ValueError(f"tuning: no {what} rows of {c.name!r} on {model!r}")
+        for family in dict.fromkeys(c.family for c in configs):
+            fam = [c.name for c in configs if c.family == family]
+            for b in budgets_ms:
+                fit = [n for n in fam if t.loc[(model, n)] <= b]
+                if not fit:
+                    continue
+                best = min(
+                    fit,
+                    key=lambda n: (
+                        q.loc[(model, n), "mean_error"],
+                        q.loc[(model, n), "work_per_step"],
+                        order[n],
+                    ),
+                )
+                c = by_name[best]
+                rows.append(
+                    {
+                        "model": model,
+                        "family": family,
+                        "budget_ms": float(b),
+                        "config": best,
+                        "member": c.member,
+                        "maxiter": c.maxiter,
+                        "restarts": c.restarts,
+                        "plan_ms": float(t.loc[(model, best)]),
+                        "work_per_step": float(q.loc[(model, best), "work_per_step"]),
+                        "mean_error": float(q.loc[(model, best), "mean_error"]),
+                        "fitting": len(fit),
+                    }
+                )
+    return pd.DataFrame(rows, columns=SELECTION_COLUMNS)
+
+
+def file_sha256(path: str | Path) -> str:
+    """SHA-256 (hex) of a file's bytes."""
+    return hashlib.sha256(Path(path).read_bytes()).hexdigest()
+
+
+def tuned_document(selection: pd.DataFrame, provenance: Mapping[str, Any]) -> dict[str, Any]:
+    """The tuned file's content: ``provenance`` and, per model and budget (ms, as text), each
+    family's chosen configuration with its tuning numbers."""
+    chosen: dict[str, dict[str, dict[str, Any]]] = {}
+    for r in selection.itertuples(index=False):
+        at = chosen.setdefault(str(r.model), {}).setdefault(f"{r.budget_ms:g}", {})
+        at[str(r.family)] = {
+            "member": str(r.member),
+            "maxiter": None if pd.isna(r.maxiter) else int(r.maxiter),
+            "restarts": int(r.restarts),
+            "tuning": {
+                "plan_ms": round(float(r.plan_ms), 4),
+                "work_per_step": round(float(r.work_per_step), 1),
+                "mean_error": round(float(r.mean_error), 4),
+                "candidates_within_budget": int(r.fitting),
+            },
+        }
+    return {"provenance": dict(provenance), "chosen": chosen}
+
+
+def tuned_configurations(doc: Mapping[str, Any], model: str) -> dict[str, dict[str, Configuration]]:
+    """Budget (text) -> family -> :class:`Configuration` of ``model`` in a tuned document."""
+    if model not in doc.get("chosen", {}):
+        raise ValueError(
+            f"tuned file: no configurations for model {model!r} "
+            f"(tuned: {', '.join(doc.get('chosen', {})) or 'none'})"
+        )
+    return {
+        b: {f: Configuration.from_spec({k: v for k, v in e.items() if k != "tuning"})
+            for f, e in fams.items()}
+        for b, fams in doc["chosen"][model].items()
+    }  # fmt: skip
+
+
+def load_yaml(path: str | Path, what: str) -> dict[str, Any]:
+    """A YAML mapping from ``path``; a missing file or bad YAML is refused naming it."""
+    p = Path(path)
+    if not p.is_file():
+        raise ValueError(f"{what}: {p} does not exist")
+    try:
+        doc = yaml.safe_load(p.read_text(encoding="utf-8"))
+    except yaml.YAMLError as exc:
+        raise ValueError(f"{what}: {p} is not valid YAML ({exc})") from None
+    if not isinstance(doc, dict):
+        raise ValueError(f"{what}: {p} must hold a mapping, got {type(doc).__name__}")
+    return doc
+
+
+@dataclass(frozen=True)
+class Preregistration:
+    """The preregistration file (module docstring): ``path``, its ``sha256`` and content."""
+
+    path: str
+    sha256: str
+    doc: Mapping[str, Any]
+
+    REQUIRED = ("stream", "tuned", "models", "budgets_ms", "headline_budget_ms", "runs", "claims")
+
+    @classmethod
+    def load(cls, path: str | Path, tuned_path: str | Path | None = None) -> Preregistration:
+        """Read and check the file: every required key, the stream ``confirm``, budgets and
+        models that the tuned file has, and (given ``tuned_path``) the tuned file's SHA-256
+        equal to the one recorded. Every problem is named; nothing is run."""
+        doc = load_yaml(path, "preregistration")
+        missing = [k for k in cls.REQUIRED if k not in doc]
+        if missing:
+            raise ValueError(f"preregistration {path}: missing {', '.join(missing)}")
+        if doc["stream"] != "confirm":
+            raise ValueError(
+                f"preregistration {path}: stream {doc['stream']!r} (allowed: 'confirm': the "
+                "verdicts come from the confirmatory stream only)"
+            )
+        runs = doc["runs"]
+        if not (isinstance(runs, int) and 2 <= runs <= 100000):
+            raise ValueError(f"preregistration {path}: runs {runs!r} (allowed: integer 2..100000)")
+        if doc["headline_budget_ms"] not in doc["budgets_ms"]:
+            raise ValueError(
+                f"preregistration {path}: headline_budget_ms {doc['headline_budget_ms']!r} is "
+                f"not one of budgets_ms {doc['budgets_ms']}"
+            )
+        if tuned_path is not None:
+            want = doc["tuned"].get("sha256")
+            got = file_sha256(tuned_path)
+            if want != got:
+                raise ValueError(
+                    f"preregistration {path}: it was written for a tuned file with sha256 "
+                    f"{want}, but {tuned_path} has {got}: the members would not be the "
+                    "preregistered ones (rerun the tuning only with a new preregistration)"
+                )
+        return cls(str(path), file_sha256(path), doc)
+
+    def configurations(self, tuned: Mapping[str, Any], model: str) -> list[Configuration]:
+        """Every configuration the confirmatory run needs on ``model``: the baseline, then the
+        tuned member of every family at every preregistered budget (each once)."""
+        per = tuned_configurations(tuned, model)
+        out = [Configuration(methods.baseline()().name)]
+        for b in self.doc["budgets_ms"]:
+            for c in per.get(f"{float(b):g}", {}).values():
+                if c not in out:
+                    out.append(c)
+        return out
+
+
+def power_runs(sd: float, effect: float, power: float = 0.8, cap: int | None = None) -> dict:
+    """Runs of a paired comparison for ``power`` at ``effect`` given the per-run ``sd`` of
+    the paired difference (:func:`rsmhp.stats.runs_for_power`), and, with a ``cap`` below
+    that, the power the capped run count gives (:func:`rsmhp.stats.t_power`)."""
+    from rsmhp.stats import runs_for_power, t_power
+
+    n = runs_for_power(sd, effect, power=power)
+    out = {"sd": sd, "effect": effect, "power": power, "runs": n}
+    if cap is not None and n > cap:
+        out.update(capped_runs=int(cap), power_at_cap=float(t_power(cap, sd, effect)))
+    return out

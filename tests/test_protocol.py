@@ -1,0 +1,239 @@
+"""The comparison protocol (rsmhp.protocol): streams, configurations, the tuning rule, the
+preregistration file, and the closed-loop and timing runs of configurations.
+
+Oracles: the exploratory stream is the config's seed; a configuration with the default budget
+is the method itself (its closed-loop row is simulate_run's summary); the tuning rule against a
+brute-force search over the same tables; the preregistration refuses what it must, naming it.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+import yaml
+
+from rsmhp import protocol
+from rsmhp.contracts import check_table
+from rsmhp.experiments.decisions_uav import merge_variant
+from rsmhp.experiments.frontier import (
+    config_runs_contract,
+    config_timing_contract,
+    run_configurations,
+    time_configurations,
+)
+from rsmhp.protocol import Configuration, Preregistration, stream_seed
+from rsmhp.uav import methods
+from rsmhp.uav.simulation import UAVSetup, simulate_run
+
+ROOT = Path(__file__).resolve().parents[1]
+CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+MODELS = [{"name": "paper"}, {"name": "footprint150", "sensor": {"footprint_radius": 150.0}}]
+
+
+def test_streams_are_the_seed_and_two_derived_roots():
+    assert stream_seed(7, "exploratory") == 7
+    tune, confirm = stream_seed(7, "tune"), stream_seed(7, "confirm")
+    assert len({7, tune, confirm}) == 3 and 0 <= tune < 2**63 and 0 <= confirm < 2**63
+    assert stream_seed(7, "confirm") == confirm and stream_seed(8, "confirm") != confirm
+    with pytest.raises(ValueError, match="stream: 'judge'"):
+        stream_seed(7, "judge")
+
+
+def test_configuration_names_budgets_and_refusals():
+    c = Configuration("rsmhp_nt64", 100, 3)
+    assert c.name == "rsmhp_nt64/it100/r3" and c.family == "rsmhp"
+    assert Configuration("rsmhp_nt64").name == "rsmhp_nt64"
+    assert Configuration("rsmhp_nt64", None, 2).name == "rsmhp_nt64/r2"
+    assert "100 it, 3 restarts" in c.label()
+    assert Configuration.from_spec(c.spec()) == c
+    base = UAVSetup.from_config(CONFIG["uav"])
+    s = c.setup(base).planner
+    assert (s.maxiter, s.maxfun, s.restarts) == (100, 201, 3)
+    assert Configuration("nbo").setup(base).planner == base.planner
+    with pytest.raises(ValueError, match="sampled-cost planners only"):
+        Configuration("dpw_s100", 30, 0)
+    with pytest.raises(ValueError, match="belongs to no registered family"):
+        Configuration("magic_nt5")
+    with pytest.raises(ValueError, match="restarts"):
+        Configuration("nbo", None, -1)
+    with pytest.raises(ValueError, match="needs 'member'"):
+        Configuration.from_spec({"maxiter": 3})
+
+
+def test_candidates_cross_every_sampled_member_with_every_optimiser_budget():
+    cfg = {
+        "methods": {"nbo": True, "rsmhp_nt": [16, 64], "sigma": True, "dpw": [{"sims": 10}]},
+        "optimiser": {"maxiter": [30, 100], "restarts": [0, 2]},
+    }
+    got = protocol.candidates(cfg)
+    sampled = [c for c in got if c.family != "dpw"]
+    assert len(sampled) == 3 * 2 * 2 and [c.member for c in got if c.family == "dpw"] == ["dpw_s10"]
+    assert all(c.family != "nbo" for c in got)  # the baseline is not tuned
+    assert len({c.name for c in got}) == len(got)
+
+
+def _tuning_tables(rng):
+    configs = [
+        Configuration("rsmhp_nt16", 30, 0),
+        Configuration("rsmhp_nt64", 30, 0),
+        Configuration("rsmhp_nt64", 30, 2),
+        Configuration("sigma", 30, 0),
+        Configuration("dpw_s10"),
+        Configuration("dpw_s50"),
+    ]
+    ms = {c.name: v for c, v in zip(configs, [0.2, 0.6, 1.5, 0.3, 0.4, 2.5], strict=True)}
+    err = {c.name: v for c, v in zip(configs, [12.0, 11.0, 10.5, 11.5, 13.0, 9.0], strict=True)}
+    q, t = [], []
+    for model, c, r in itertools.product(("a", "b"), configs, range(4)):
+        q.append(
+            {
+                "model": model,
+                "config": c.name,
+                "run": r,
+                "work_per_step": 10.0 * r,
+                "mean_error": err[c.name] + (0.5 if model == "b" else 0) + 0.01 * (r - 1.5),
+            }
+        )
+        t.append({"model": model, "config": c.name, "ms": ms[c.name] * (1 + 0.01 * r)})  # fmt: skip
+    return configs, pd.DataFrame(q), pd.DataFrame(t)
+
+
+def test_selection_is_the_best_error_within_each_budget():
+    configs, q, t = _tuning_tables(np.random.default_rng(0))
+    budgets = [0.25, 1.0, 4.0]
+    sel = protocol.select(q, t, configs, budgets)
+    assert list(sel.columns) == protocol.SELECTION_COLUMNS
+    # brute force over the same tables
+    med = t.groupby(["model", "config"])["ms"].median()
+    mean = q.groupby(["model", "config"])["mean_error"].mean()
+    for model in ("a", "b"):
+        for fam in ("rsmhp", "sigma", "dpw"):
+            for b in budgets:
+                fit = [c.name for c in configs if c.family == fam and med[(model, c.name)] <= b]
+                row = sel[(sel.model == model) & (sel.family == fam) & (sel.budget_ms == b)]
+                if not fit:
+                    assert row.empty
+                    continue
+                assert row["config"].item() == min(fit, key=lambda n: mean[(model, n)])
+                assert row["fitting"].item() == len(fit)
+    r = sel[(sel.model == "a") & (sel.family == "rsmhp")].set_index("budget_ms")["config"]
+    assert r.to_dict() == {0.25: "rsmhp_nt16/it30/r0", 1.0: "rsmhp_nt64/it30/r0",
+                           4.0: "rsmhp_nt64/it30/r2"}  # fmt: skip
+    with pytest.raises(ValueError, match="no timing rows of 'dpw_s50'"):
+        protocol.select(q, t[t.config != "dpw_s50"], configs, budgets)
+
+
+def test_tuned_document_round_trips_into_configurations():
+    configs, q, t = _tuning_tables(np.random.default_rng(0))
+    sel = protocol.select(q, t, configs, [1.0, 4.0])
+    doc = protocol.tuned_document(sel, {"stream": "tune"})
+    doc = yaml.safe_load(yaml.safe_dump(doc))
+    per = protocol.tuned_configurations(doc, "a")
+    assert per["4"]["rsmhp"] == Configuration("rsmhp_nt64", 30, 2)
+    assert per["1"]["dpw"] == Configuration("dpw_s10")
+    with pytest.raises(ValueError, match="no configurations for model 'c'"):
+        protocol.tuned_configurations(doc, "c")
+
+
+def _prereg(tmp_path, tuned_sha, **over):
+    doc = {
+        "stream": "confirm",
+        "tuned": {"file": "tuned.yaml", "sha256": tuned_sha},
+        "models": ["a"],
+        "budgets_ms": [1.0, 4.0],
+        "headline_budget_ms": 1.0,
+        "runs": 30,
+        "claims": {},
+        **over,
+    }
+    p = tmp_path / "prereg.yaml"
+    p.write_text(yaml.safe_dump(doc))
+    return p
+
+
+def test_preregistration_checks_the_tuned_file_and_lists_the_configurations(tmp_path):
+    configs, q, t = _tuning_tables(np.random.default_rng(0))
+    doc = protocol.tuned_document(protocol.select(q, t, configs, [1.0, 4.0]), {})
+    tuned = tmp_path / "tuned.yaml"
+    tuned.write_text(yaml.safe_dump(doc))
+    p = _prereg(tmp_path, protocol.file_sha256(tuned))
+    pre = Preregistration.load(p, tuned)
+    assert pre.sha256 == protocol.file_sha256(p)
+    got = [c.name for c in pre.configurations(doc, "a")]
+    assert got[0] == "nbo" and len(got) == len(set(got))
+    assert {"rsmhp_nt64/it30/r0", "rsmhp_nt64/it30/r2", "dpw_s10", "sigma/it30/r0"} <= set(got)
+    tuned.write_text(yaml.safe_dump({**doc, "provenance": {"edited": True}}))
+    with pytest.raises(ValueError, match="would not be the preregistered ones"):
+        Preregistration.load(p, tuned)
+    with pytest.raises(ValueError, match="stream 'tune'"):
+        Preregistration.load(_prereg(tmp_path, "x", stream="tune"))
+    with pytest.raises(ValueError, match=r"headline_budget_ms 2\.0"):
+        Preregistration.load(_prereg(tmp_path, "x", headline_budget_ms=2.0))
+    with pytest.raises(ValueError, match="missing claims"):
+        bad = yaml.safe_load(_prereg(tmp_path, "x").read_text())
+        del bad["claims"]
+        (tmp_path / "bad.yaml").write_text(yaml.safe_dump(bad))
+        Preregistration.load(tmp_path / "bad.yaml")
+    with pytest.raises(ValueError, match="does not exist"):
+        Preregistration.load(tmp_path / "none.yaml")
+
+
+def test_power_runs_caps_and_reports_the_power_it_gives():
+    from rsmhp.stats import runs_for_power, t_power
+
+    out = protocol.power_runs(2.0, 0.5)
+    assert out["runs"] == runs_for_power(2.0, 0.5) and "capped_runs" not in out
+    capped = protocol.power_runs(2.0, 0.5, cap=20)
+    assert capped["capped_runs"] == 20 and capped["power_at_cap"] == t_power(20, 2.0, 0.5)
+    assert capped["power_at_cap"] < 0.8
+
+
+# ------------------------------------------------------------------ runs of configurations
+
+
+def _uav() -> dict:
+    cfg = copy.deepcopy(CONFIG["uav"])
+    cfg["scenario"]["steps"] = 6
+    cfg["planner"].update(horizon=3, maxiter=6, maxfun=12)
+    return cfg
+
+
+def test_a_default_configuration_runs_its_method_and_restarts_share_its_hypotheses():
+    configs = [
+        Configuration("nbo"),
+        Configuration("rsmhp_nt16"),
+        Configuration("rsmhp_nt16", 6, 3),
+        Configuration("dpw_s20"),
+    ]
+    seed = stream_seed(5, "tune")
+    rows = run_configurations(_uav(), MODELS, "footprint150", configs, [0, 1], seed, 50.0)
+    check_table(rows, "runs", config_runs_contract("x", configs, [0, 1], "footprint150"))
+    setup = UAVSetup.from_config(merge_variant(_uav(), MODELS[1]))
+    for name in ("nbo", "rsmhp_nt16", "dpw_s20"):
+        for run in (0, 1):
+            s, _ = simulate_run(setup, methods.from_name(name), seed, run)
+            row = rows[(rows.config == name) & (rows.run == run)].iloc[0]
+            assert (
+                row["mean_error"] == s["mean_error"] and row["work_per_step"] == s["work_per_step"]
+            )
+    r = rows.set_index(["config", "run"])
+    # the restarts spend more work on the same hypotheses (same stream key as the method)
+    assert (
+        r.loc["rsmhp_nt16/it6/r3", "work_per_step"] > r.loc["rsmhp_nt16", "work_per_step"]
+    ).all()
+    assert r.loc["dpw_s20", "plan_depth"].notna().all() and r.loc["nbo", "plan_depth"].isna().all()
+
+
+def test_configuration_timing_is_round_robin_with_the_contract():
+    configs = [Configuration("nbo"), Configuration("rsmhp_nt16", 6, 1), Configuration("dpw_s20")]
+    timing = {"runs": 1, "steps": [0, 2, 3], "repeats": 3}
+    t = time_configurations(_uav(), MODELS, "paper", configs, timing, 5)
+    check_table(t, "timing", config_timing_contract("x", configs, timing, "paper"))
+    slots = t.groupby(["config", "slot"]).size().unstack()
+    assert (slots == 3).all().all()  # 3 repeats x 3 states = 9 calls, 3 per slot
+    assert (t.groupby(["config", "run", "step"])["work"].nunique() == 1).all()
