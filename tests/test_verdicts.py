@@ -185,7 +185,9 @@ def test_holm_sections_corrects_across_sections_and_keeps_their_claims():
     from rsmhp.ledger import Section
     from rsmhp.verdicts import holm_correct, holm_sections
 
-    a = Section("a", "A", 1, "", [_claim("FR-1-x", "supported", 0.03), _claim("X-1", "supported", None)])
+    a = Section(
+        "a", "A", 1, "", [_claim("FR-1-x", "supported", 0.03), _claim("X-1", "supported", None)]
+    )
     b = Section("b", "B", 2, "", [_claim("HZ-1-x", "supported", 0.04)])
     out = holm_sections([a, b])
     want = holm_correct([*a.claims, *b.claims])

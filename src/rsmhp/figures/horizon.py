@@ -7,7 +7,8 @@ relative bias (%). ``hz_uav_time``: top row the median planning milliseconds per
 (log scale), bottom row the open-loop regret against the best of the methods' own plans (% of
 the best cost; it mixes approximation and optimisation error, which the optimiser-split study
 separates). x: the horizon H (log scale). ``hz_uav_closed``: the closed-loop mean location
-error minus NBO's on the same runs (m, 95% Student-t CIs over runs). One line per method in its palette colour.
+error minus NBO's on the same runs (m, 95% Student-t CIs over runs). One line per method in
+its palette colour.
 
 ``hz_lqg`` (oven LQG, exact oracle; one row per simulated a): left, the relative RMSE (%,
 log scale) of each cost estimator with n trajectories (the largest n of the study: Monte
