@@ -9,11 +9,13 @@ CORES ?= 2
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.rsmhp-installed
 
-.PHONY: help replicate publish verify portability test lint setup clean
+.PHONY: help replicate tune publish verify portability test lint setup clean
 
 help:
 	@echo "rsmhp: replication pipeline (RS-MHP vs NBO). Targets:"
 	@echo "  make replicate [ARGS=...]  set up .venv if needed, run the full replication (snakemake -j$(CORES) ARGS)"
+	@echo "  make tune [ARGS=...]       the protocol's tuning (tuning stream; not in replicate), then"
+	@echo "                             copy results/tune/tuned.yaml to config/tuned.yaml"
 	@echo "  make verify [ARGS=...]     run what is missing, compare every claim with paper/claims.json"
 	@echo "  make portability [ARGS=...] rerun as on another CPU (numba generic, OpenBLAS Nehalem, no"
 	@echo "                             numpy SIMD) elsewhere; compare with results/ and paper/claims.json"
@@ -41,6 +43,14 @@ setup: $(STAMP)
 # extra snakemake flags: make replicate ARGS="--rerun-incomplete"
 replicate: $(STAMP)
 	$(BIN)/snakemake -j$(CORES) $(ARGS)
+
+# the protocol's tuning on its own seed stream (not part of replicate): every candidate in closed
+# loop and in an interleaved timing, the selection rule, and the tuned file copied to config/
+# (tracked: a new preregistration must follow before the next confirmatory run)
+tune: $(STAMP)
+	$(BIN)/snakemake -j$(CORES) tune $(ARGS)
+	cp results/tune/tuned.yaml config/tuned.yaml
+	@echo "config/tuned.yaml written: write and commit a new config/preregistration.yaml before the confirmatory run"
 
 # copy the report of results/ into the tracked paper/ (the only target that changes tracked files)
 # copy the report, its claims (the reference of make verify) and the README's glance table

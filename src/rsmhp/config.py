@@ -271,6 +271,15 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
         ("decisions.uav.steps", (dec.get("uav", {}) or {}).get("steps", [])),
         ("decisions.map.regret_steps", (dec.get("map", {}) or {}).get("regret_steps", [])),
         ("decisions.frontier.regret_steps", fr.get("regret_steps", [])),
+        ("decisions.frontier.timing.steps", (fr.get("timing", {}) or {}).get("steps", [])),
+        (
+            "decisions.frontier.tuning.timing.steps",
+            ((fr.get("tuning", {}) or {}).get("timing", {}) or {}).get("steps", [0, 7, 20]),
+        ),
+        (
+            "decisions.frontier.confirm.timing.steps",
+            ((fr.get("confirm", {}) or {}).get("timing", {}) or {}).get("steps", [0, 7, 20]),
+        ),
     ):
         late = [s for s in steps or [] if isinstance(s, int) and s >= n_steps]
         if late:

@@ -64,6 +64,7 @@ __all__ = [
     "file_sha256",
     "select",
     "stream_seed",
+    "tuning_configurations",
 ]
 
 #: the seed streams of the protocol (:func:`stream_seed`)
@@ -147,6 +148,12 @@ class Configuration:
                 f"'restarts' (unknown: {sorted(unknown)})"
             )
         return cls(str(spec["member"]), spec.get("maxiter"), int(spec.get("restarts", 0)))
+
+
+def tuning_configurations(tuning: Mapping[str, Any]) -> list[Configuration]:
+    """Everything the tuning runs: the baseline (as the tables' reference, not tuned), then
+    :func:`candidates` of ``tuning["candidates"]`` (``decisions.frontier.tuning``)."""
+    return [Configuration(methods.baseline()().name), *candidates(tuning["candidates"])]
 
 
 def candidates(cfg: Mapping[str, Any]) -> list[Configuration]:

@@ -167,3 +167,94 @@ rule frontier:
         rules.decisions_frontier_summary.output if FRONTIER_MODELS else [],
         rules.decisions_frontier_figures.output if FRONTIER_MODELS else [],
         rules.decisions_frontier_recording.output if FRONTIER_MODELS else [],
+
+
+# ---------------------------------------------------------------------------- the protocol
+# Tuning (target `tune`, `make tune`; not part of the default run): every candidate of
+# decisions.frontier.tuning in closed loop and in an interleaved timing on the tuning stream,
+# then the selection rule (rsmhp.protocol.select) writes results/tune/tuned.yaml.
+TUNING = FRONTIER["tuning"]
+
+
+rule frontier_tune:
+    """Protocol tuning, one model variant: closed-loop runs of every candidate configuration on the tuning stream."""
+    output:
+        "results/tune/frontier/{model}.csv",
+    log:
+        "results/logs/frontier_tune/{model}.log",
+    benchmark:
+        "results/benchmarks/frontier_tune/{model}.tsv"
+    priority: PRIORITY["decisions_frontier"]
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=120,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(config["decisions"]["uav"]["models"]),
+        tuning=canonical(TUNING),
+        track_loss_error=FRONTIER["track_loss_error"],
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/frontier_tune.py"),
+    script:
+        "../scripts/frontier_tune.py"
+
+
+rule frontier_tune_timing:
+    """Protocol tuning, one model variant: interleaved wall-clock timing of every candidate (holds the cores)."""
+    output:
+        "results/tune/frontier/timing/{model}.csv",
+    log:
+        "results/logs/frontier_tune_timing/{model}.log",
+    benchmark:
+        "results/benchmarks/frontier_tune_timing/{model}.tsv"
+    conda:
+        ENV
+    # plans on one thread but holds two: nothing runs beside it on the 2-core machine
+    threads: 2
+    resources:
+        mem_mb=2000,
+        runtime=30,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(config["decisions"]["uav"]["models"]),
+        tuning=canonical(TUNING),
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/frontier_tune_timing.py"),
+    script:
+        "../scripts/frontier_tune_timing.py"
+
+
+rule frontier_tune_select:
+    """Protocol tuning: the configuration of every family at every budget (results/tune/tuned.yaml; make tune copies it to config/)."""
+    input:
+        runs=expand("results/tune/frontier/{model}.csv", model=FRONTIER_MODELS),
+        timing=expand("results/tune/frontier/timing/{model}.csv", model=FRONTIER_MODELS),
+    output:
+        tuned="results/tune/tuned.yaml",
+        selection="results/tune/selection.csv",
+        table="results/tune/tuning.md",
+    log:
+        "results/logs/frontier_tune_select.log",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        models=FRONTIER_MODELS,
+        tuning=canonical(TUNING),
+        seed=config["seed"],
+        config=canonical(config),
+        code=code_digest("workflow/scripts/frontier_tune_select.py"),
+    script:
+        "../scripts/frontier_tune_select.py"
+
+
+rule tune:
+    """Target: the protocol's tuning (not part of the default run): results/tune/tuned.yaml."""
+    input:
+        rules.frontier_tune_select.output if FRONTIER_MODELS else [],

@@ -1,0 +1,17 @@
+"""Rule frontier_tune: closed-loop runs of every tuning candidate (and NBO) on one model
+variant, on the tuning stream."""
+
+from rsmhp.experiments.frontier import run_configurations
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+from rsmhp.protocol import stream_seed, tuning_configurations
+
+with rule_logging(snakemake):
+    p = snakemake.params
+    configs = tuning_configurations(p.tuning)
+    runs = range(int(p.tuning["runs"]))
+    seed = stream_seed(p.seed, "tune")
+    table = run_configurations(
+        p.uav, p.models, snakemake.wildcards.model, configs, runs, seed, p.track_loss_error
+    )
+    write_csv(table, snakemake.output[0])

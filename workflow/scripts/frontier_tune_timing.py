@@ -1,0 +1,16 @@
+"""Rule frontier_tune_timing: interleaved wall-clock timing of every tuning candidate (and
+NBO) on one model variant, at belief states of the tuning stream."""
+
+from rsmhp.experiments.frontier import time_configurations
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+from rsmhp.protocol import stream_seed, tuning_configurations
+
+with rule_logging(snakemake):
+    p = snakemake.params
+    configs = tuning_configurations(p.tuning)
+    seed = stream_seed(p.seed, "tune")
+    table = time_configurations(
+        p.uav, p.models, snakemake.wildcards.model, configs, p.tuning["timing"], seed
+    )
+    write_csv(table, snakemake.output[0])
