@@ -236,7 +236,7 @@ def test_missing_members_drop_their_claims_only():
         _claims(cfg)
 
 
-def test_section_states_every_claim_and_the_budget():
+def test_exploratory_section_states_every_comparison_and_the_budget():
     from rsmhp.narrative.frontier import frontier_section, frontier_tables
 
     runs, regret = _tables()
@@ -245,12 +245,10 @@ def test_section_states_every_claim_and_the_budget():
            "track_loss_error": 50.0}  # fmt: skip
     tables = frontier_tables(summary, cfg)
     sec = frontier_section(runs, regret, summary, tables, cfg, seed=11, horizon=6)
-    assert sec.key == "decisions_frontier" and [c.id for c in sec.claims] == [
-        "FR-1-m",
-        "FR-2-m",
-        "FR-3-m",
-    ]
-    for c in sec.claims:
+    # the exploratory design: its comparisons are printed, never claims of the ledger
+    assert sec.key == "decisions_frontier_exploratory" and sec.claims == []
+    assert "Exploratory comparisons (not claims)" in sec.body
+    for c in _claims().values():
         k = c.key
         assert f"'m' {fmt(k.value, k.digits, True)}" in sec.body and f"({c.verdict})" in sec.body
     assert "56 equally weighted cubature points" in sec.appendix  # 8 (H + 1), H = 6

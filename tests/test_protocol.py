@@ -237,3 +237,132 @@ def test_configuration_timing_is_round_robin_with_the_contract():
     slots = t.groupby(["config", "slot"]).size().unstack()
     assert (slots == 3).all().all()  # 3 repeats x 3 states = 9 calls, 3 per slot
     assert (t.groupby(["config", "run", "step"])["work"].nunique() == 1).all()
+
+
+# ------------------------------------------------------------ confirmatory statistics and claims
+
+
+def _confirm_tables(shift_rqmc=-0.5, shift_dpw=3.0, n=30, noise=0.3):
+    """One model 'm', NBO and tuned members at two budgets: rsmhp (the reference), rqmc,
+    sigma, dpw; each run's error = a shared scenario part + the member's shift + its own
+    noise. Interleaved timing rows with known medians."""
+    rng = np.random.default_rng(3)
+    common = rng.normal(20.0, 4.0, n)
+    members = {
+        "nbo": ("nbo", 0.0, 0.1, None),
+        "rsmhp_nt16/it30/r0": ("rsmhp", -1.0, 0.3, "rsmhp_nt16"),
+        "rsmhp_nt64/it30/r1": ("rsmhp", -1.2, 1.5, "rsmhp_nt64"),
+        "rqmc_nt16/it30/r0": ("rqmc", -1.0 + shift_rqmc, 0.4, "rqmc_nt16"),
+        "sigma/it30/r0": ("sigma", -1.1, 0.2, "sigma"),
+        "dpw_s30": ("dpw", -1.0 + shift_dpw, 0.9, "dpw_s30"),
+    }
+    runs, timing = [], []
+    for name, (fam, shift, ms, member) in members.items():
+        own = noise * rng.standard_normal(n)
+        for r in range(n):
+            runs.append({"model": "m", "config": name, "member": member or "nbo", "family": fam,
+                         "maxiter": 30, "restarts": 1 if name.endswith("r1") else 0, "run": r,
+                         "mean_error": common[r] + shift + own[r], "final_error": 1.0,
+                         "detect_rate": 1.0, "lost": False, "plan_ms": ms, "mean_nit": 5.0,
+                         "work_per_step": 100.0 * ms, "converged_rate": 1.0,
+                         "plan_depth": 2.0 if fam == "dpw" else np.nan,
+                         "max_depth": 3.0 if fam == "dpw" else np.nan,
+                         "root_actions": 9.0 if fam == "dpw" else np.nan,
+                         "frac_depth1": 0.2 if fam == "dpw" else np.nan})  # fmt: skip
+        for rep in range(2):
+            for k in range(3):
+                timing.append({"model": "m", "config": name, "repeat": rep, "run": 0, "step": k,
+                               "slot": 0, "ms": ms * (1 + 0.01 * k + 0.02 * rep),
+                               "work": int(100 * ms)})  # fmt: skip
+    chosen = {
+        "m": {
+            "0.5": {"rsmhp": Configuration("rsmhp_nt16", 30, 0),
+                    "rqmc": Configuration("rqmc_nt16", 30, 0),
+                    "sigma": Configuration("sigma", 30, 0)},
+            "2": {"rsmhp": Configuration("rsmhp_nt64", 30, 1),
+                  "rqmc": Configuration("rqmc_nt16", 30, 0),
+                  "sigma": Configuration("sigma", 30, 0),
+                  "dpw": Configuration("dpw_s30")},
+        }
+    }  # fmt: skip
+    return pd.DataFrame(runs), pd.DataFrame(timing), chosen
+
+
+PREREG = {
+    "models": ["m"],
+    "budgets_ms": [0.5, 2.0],
+    "headline_budget_ms": 2.0,
+    "runs": 30,
+    "claims": {
+        "FR-1": {"family": "rqmc", "against": "rsmhp", "test": "superiority", "margin_m": 0.25},
+        "FR-2": {"family": "sigma", "against": "rsmhp", "test": "non-inferiority",
+                 "margin_m": 0.25},
+        "FR-3": {"family": "dpw", "against": "rsmhp", "test": "superiority", "margin_m": 0.25},
+    },
+}  # fmt: skip
+
+
+def test_confirm_summary_ladder_and_claims_follow_the_data():
+    from rsmhp.analysis.frontier import ladder, paired_configs, prob_improvement, summarize_configs
+    from rsmhp.claims.frontier import confirm_claims
+    from rsmhp.stats import mean_ci
+
+    runs, timing, chosen = _confirm_tables()
+    s = summarize_configs(runs, timing).set_index("config")
+    assert s.loc["rsmhp_nt64/it30/r1", "plan_ms"] == pytest.approx(np.median(
+        [1.5 * (1 + 0.01 * k + 0.02 * r) for r in range(2) for k in range(3)]))  # fmt: skip
+    w = runs.pivot(index="run", columns="config", values="mean_error")
+    d = (w["dpw_s30"] - w["nbo"]).to_numpy()
+    assert (s.loc["dpw_s30", "error_diff_low"], s.loc["dpw_s30", "error_diff_high"]) == (
+        pytest.approx(mean_ci(d)[1:])
+    )
+    assert s.loc["dpw_s30", "plan_depth"] == 2.0 and np.isnan(s.loc["nbo", "plan_depth"])
+    lad = ladder(runs, summarize_configs(runs, timing), chosen, [0.5, 2.0])
+    r = lad.set_index(["budget_ms", "family"])
+    assert r.loc[(0.5, "rsmhp"), "within_budget"] and r.loc[(2.0, "rsmhp"), "within_budget"]
+    assert r.loc[(2.0, "rsmhp"), "diff_mc"] == 0.0
+    p = paired_configs(runs, "m", "rqmc_nt16/it30/r0", "rsmhp_nt64/it30/r1")
+    assert r.loc[(2.0, "rqmc"), "diff_mc"] == pytest.approx(p.mean)
+    pi = prob_improvement(w["rqmc_nt16/it30/r0"].to_numpy(), w["rsmhp_nt64/it30/r1"].to_numpy())
+    assert r.loc[(2.0, "rqmc"), "p_improve"] == pytest.approx(pi[0])
+    assert "dpw" not in set(lad[lad.budget_ms == 0.5]["family"])
+    claims = {c.id: c for c in confirm_claims(runs, summarize_configs(runs, timing), lad,
+                                              PREREG, chosen, "abc123" * 6)}  # fmt: skip
+    assert set(claims) == {"FR-1-m", "FR-2-m", "FR-3-m"}
+    for c in claims.values():
+        lo, hi = c.key.ci_low, c.key.ci_high
+        assert c.verdict in ("supported", "not supported", "equivalent", "inconclusive")
+        assert "preregistered, sha256 abc123abc123" in c.rule
+        assert 0 <= c.key.p_value <= 1 and lo <= c.key.value <= hi
+    # rqmc (shift -1.5) against the 2 ms Monte-Carlo member (-1.2): d = -0.3 m with a
+    # per-run sd of 0.3 sqrt 2, SE 0.077 at 30 runs: the CI lies below -0.25 and 0
+    assert claims["FR-1-m"].verdict == "supported"
+    assert claims["FR-3-m"].verdict == "not supported"  # dpw +3 m worse than Monte Carlo's
+    assert claims["FR-3-m"].key.p_value < 0.05
+    assert "follow its tree for 2.00 of H steps" in claims["FR-3-m"].measured
+    assert claims["FR-2-m"].key.null == 0.25
+    assert "rsmhp_nt64" not in claims["FR-1-m"].contrary
+
+
+def test_confirm_section_reads_its_numbers_from_the_tables():
+    from rsmhp.analysis.frontier import ladder, summarize_configs
+    from rsmhp.claims.frontier import confirm_claims
+    from rsmhp.narrative.frontier import confirm_section, confirm_tables
+
+    runs, timing, chosen = _confirm_tables()
+    s = summarize_configs(runs, timing)
+    lad = ladder(runs, s, chosen, [0.5, 2.0])
+    claims = confirm_claims(runs, s, lad, PREREG, chosen, "f" * 64)
+    tuned = {"provenance": {"candidates": 7, "runs per candidate": 4}, "chosen": {}}
+    tables = confirm_tables(s, lad, tuned)
+    sec = confirm_section(s, lad, claims, tables, {**PREREG, "power_text": "p"},
+                          {"path": "p.yaml", "sha256": "f" * 64, "commit": "c" * 40}, tuned,
+                          [{"id": "FR-1-x", "key": {"value": 1.0, "ci_low": 0.5,
+                                                    "ci_high": 1.5, "unit": "m"},
+                            "verdict": "supported"}])  # fmt: skip
+    assert sec.key == "decisions_frontier" and len(sec.claims) == 3
+    assert "7 candidate configurations" in sec.body and "sha256 ffffffffffff" in sec.body
+    for c in claims:
+        assert f"{c.id}" in sec.body
+    assert "FR-1-x" in sec.appendix and "76a0c01" in sec.appendix
+    assert "(no tuned configurations)" in tables["dec_confirm_tuning"]

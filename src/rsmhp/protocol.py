@@ -61,6 +61,8 @@ __all__ = [
     "Configuration",
     "Preregistration",
     "candidates",
+    "confirm_plan",
+    "file_commit",
     "file_sha256",
     "select",
     "stream_seed",
@@ -328,8 +330,17 @@ class Preregistration:
                 "verdicts come from the confirmatory stream only)"
             )
         runs = doc["runs"]
-        if not (isinstance(runs, int) and 2 <= runs <= 100000):
-            raise ValueError(f"preregistration {path}: runs {runs!r} (allowed: integer 2..100000)")
+        per = runs if isinstance(runs, dict) else dict.fromkeys(doc["models"], runs)
+        bad = {
+            m: n
+            for m, n in per.items()
+            if not (isinstance(n, int) and not isinstance(n, bool) and 2 <= n <= 100000)
+        }
+        if bad or set(per) != set(doc["models"]):
+            raise ValueError(
+                f"preregistration {path}: runs {runs!r} (allowed: an integer 2..100000, or one "
+                f"per model of {doc['models']})"
+            )
         if doc["headline_budget_ms"] not in doc["budgets_ms"]:
             raise ValueError(
                 f"preregistration {path}: headline_budget_ms {doc['headline_budget_ms']!r} is "
@@ -345,6 +356,11 @@ class Preregistration:
                     "preregistered ones (rerun the tuning only with a new preregistration)"
                 )
         return cls(str(path), file_sha256(path), doc)
+
+    def runs(self, model: str) -> int:
+        """The confirmatory runs of ``model``."""
+        r = self.doc["runs"]
+        return int(r[model] if isinstance(r, dict) else r)
 
     def configurations(self, tuned: Mapping[str, Any], model: str) -> list[Configuration]:
         """Every configuration the confirmatory run needs on ``model``: the baseline, then the
@@ -369,3 +385,67 @@ def power_runs(sd: float, effect: float, power: float = 0.8, cap: int | None = N
     if cap is not None and n > cap:
         out.update(capped_runs=int(cap), power_at_cap=float(t_power(cap, sd, effect)))
     return out
+
+
+def file_commit(path: str | Path) -> str:
+    """The last commit that changed ``path`` (``git log -1``), ``"uncommitted"`` if the file
+    differs from it or was never committed, ``"unknown"`` outside a git checkout."""
+    import subprocess
+
+    p = Path(path)
+    try:
+        out = subprocess.run(
+            ["git", "log", "-1", "--format=%H", "--", p.name],
+            cwd=p.parent,
+            capture_output=True,
+            text=True,
+            check=True,
+            timeout=30,
+        ).stdout.strip()
+        dirty = subprocess.run(
+            ["git", "status", "--porcelain", "--", p.name],
+            cwd=p.parent,
+            capture_output=True,
+            text=True,
+            check=True,
+            timeout=30,
+        ).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return "unknown"
+    return out if out and not dirty else "uncommitted"  # fmt: skip
+
+
+def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, Any] | None:
+    """What the workflow's confirmatory rules need (JSON-ready, the rules' params): the
+    preregistration (content, path, sha256, commit), the tuned file (content, sha256), and
+    per model its runs and configurations; ``None`` when ``decisions.frontier`` has no model
+    or the preregistration file does not exist (the report then has no FR claims). A
+    preregistration that does not fit the tuned file, or names a model outside
+    ``decisions.frontier.models``, is refused naming both."""
+    if not frontier.get("models"):
+        return None
+    conf = frontier["confirm"]
+    base = Path(basedir)
+    pre_path, tuned_path = base / conf["preregistration"], base / conf["tuned"]
+    if not pre_path.is_file():
+        return None
+    pre = Preregistration.load(pre_path, tuned_path)
+    tuned = load_yaml(tuned_path, "tuned file")
+    outside = [m for m in pre.doc["models"] if m not in frontier["models"]]
+    if outside:
+        raise ValueError(
+            f"preregistration {conf['preregistration']}: models {outside} are not in "
+            f"decisions.frontier.models ({list(frontier['models'])})"
+        )
+    models = list(pre.doc["models"])
+    return {
+        "preregistration": dict(pre.doc),
+        "path": str(conf["preregistration"]),
+        "sha256": pre.sha256,
+        "commit": file_commit(pre_path),
+        "tuned": tuned,
+        "tuned_sha256": file_sha256(tuned_path),
+        "models": models,
+        "runs": {m: pre.runs(m) for m in models},
+        "plans": {m: [c.spec() for c in pre.configurations(tuned, m)] for m in models},
+    }

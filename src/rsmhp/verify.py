@@ -152,7 +152,8 @@ def render(table: pd.DataFrame, reference: str, run: str) -> str:
 
 def verify(reference: str | os.PathLike, run: str | os.PathLike) -> tuple[bool, str]:
     """Compare two claims files; (all agree, Markdown report). ``ValueError`` if they come
-    from different configurations (nothing to compare claim by claim)."""
+    from different configurations or were judged under different preregistrations (their
+    ``preregistration.sha256``): nothing to compare claim by claim."""
     ref_claims, ref_hash = load_claims(reference)
     run_claims, run_hash = load_claims(run)
     if ref_hash != run_hash:
@@ -160,6 +161,15 @@ def verify(reference: str | os.PathLike, run: str | os.PathLike) -> tuple[bool, 
             f"{run} comes from config sha256 {run_hash}, the reference {reference} from "
             f"{ref_hash}: verify compares runs of the same configuration (config/config.yaml "
             "without overrides for paper/claims.json)"
+        )
+    ref_pre, run_pre = load_preregistration(reference), load_preregistration(run)
+    if ref_pre.get("sha256") != run_pre.get("sha256"):
+        raise ValueError(
+            f"{run} was judged under preregistration sha256 {run_pre.get('sha256')} "
+            f"({run_pre.get('path')}), the reference {reference} under "
+            f"{ref_pre.get('sha256')} ({ref_pre.get('path')}): verify compares runs of the "
+            "same preregistration (restore the committed config/preregistration.yaml and "
+            "config/tuned.yaml, or publish a new reference after a new preregistration)"
         )
     table = compare(ref_claims, run_claims)
     ok = bool((table["status"] == "ok").all())
@@ -170,6 +180,13 @@ def verify(reference: str | os.PathLike, run: str | os.PathLike) -> tuple[bool, 
         text = text.replace("# verify: PASS", "# verify: FAIL", 1)
         text += "\nStatements of the paper whose verdict differs: " + "; ".join(flips) + "\n"
     return ok, text
+
+
+def load_preregistration(path: str | os.PathLike) -> dict[str, str]:
+    """The ``preregistration`` record of a ``claims.json`` (path, sha256, commit of the file
+    the run was judged under); empty for a file without one (no confirmatory run)."""
+    data = json.loads(Path(path).read_text(encoding="utf-8"))
+    return dict(data.get("preregistration") or {})
 
 
 def load_statements(path: str | os.PathLike) -> dict[str, str]:

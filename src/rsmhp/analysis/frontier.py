@@ -31,7 +31,7 @@ measured time against the budget and the largest member of its family that fits 
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
@@ -43,13 +43,19 @@ from rsmhp.uav import methods
 
 __all__ = [
     "BUDGET_COLUMNS",
+    "CONFIG_SUMMARY_COLUMNS",
     "FRONTIER_SUMMARY_COLUMNS",
+    "LADDER_COLUMNS",
     "RUN_SELECTIONS",
     "Paired",
     "budget_check",
     "cluster_mean_ci",
+    "ladder",
+    "paired_configs",
     "paired_difference",
+    "prob_improvement",
     "select_run",
+    "summarize_configs",
     "summarize_frontier",
     "timing_summary",
 ]
@@ -331,3 +337,188 @@ def select_run(
         key = d if rule == "largest_gain" else -d
     run = int(key.index[int(np.argmin(key.to_numpy(float)))])
     return run, float(d.loc[run])
+
+
+# ------------------------------------------------------------------------ the protocol
+
+#: per (model, configuration) of the confirmatory run (:func:`summarize_configs`)
+CONFIG_SUMMARY_COLUMNS = [
+    "model",
+    "config",
+    "member",
+    "family",
+    "maxiter",
+    "restarts",
+    "plan_ms",
+    "plan_lo_ms",
+    "plan_hi_ms",
+    "loop_ms",
+    "work_per_step",
+    "mean_nit",
+    "converged_rate",
+    "plan_depth",
+    "max_depth",
+    "root_actions",
+    "frac_depth1",
+    "runs",
+    "mean_error",
+    "error_diff",
+    "error_diff_low",
+    "error_diff_high",
+    "lost_rate",
+]
+
+
+def summarize_configs(runs: pd.DataFrame, timing: pd.DataFrame) -> pd.DataFrame:
+    """Per (model, configuration) of a protocol run (:data:`CONFIG_SUMMARY_COLUMNS`): compute
+    in both units (interleaved wall clock: median and per-pass range; closed loop's own
+    time; model steps, iterations, convergence, a tree search's depth statistics, each the
+    median or mean over runs), mean location error and its paired difference with NBO over
+    runs with the 95% t interval (one value per run). ``runs``:
+    :data:`rsmhp.experiments.frontier.CONFIG_RUN_COLUMNS`; ``timing``:
+    :data:`rsmhp.experiments.frontier.CONFIG_TIMING_COLUMNS`."""
+    base = methods.baseline()().name
+    times = timing_summary(timing.rename(columns={"config": "method"}))
+    out = []
+    for model, g in runs.groupby("model", sort=False):
+        err = g.pivot(index="run", columns="config", values="mean_error")
+        if base not in err.columns:
+            raise ValueError(f"runs: no {base!r} rows on {model!r} (every comparison needs it)")
+        for config, m in g.groupby("config", sort=False):
+            if (model, config) not in times.index:
+                raise ValueError(f"timing: no interleaved timing of {config!r} on {model!r}")
+            d = (err[config] - err[base]).to_numpy(float)
+            lo, hi = _cluster_ci(d, err.index.to_numpy())
+            conv = m["converged_rate"]
+            out.append(
+                {
+                    "model": model,
+                    "config": config,
+                    "member": m["member"].iloc[0],
+                    "family": m["family"].iloc[0],
+                    "maxiter": int(m["maxiter"].iloc[0]),
+                    "restarts": int(m["restarts"].iloc[0]),
+                    **{k: float(v) for k, v in times.loc[(model, config)].items()},
+                    "loop_ms": float(m["plan_ms"].median()),
+                    "work_per_step": float(m["work_per_step"].median()),
+                    "mean_nit": float(m["mean_nit"].mean()),
+                    "converged_rate": float(conv.mean()) if conv.notna().any() else float("nan"),
+                    **{k: float(m[k].mean()) for k in _DEPTH},
+                    "runs": len(m),
+                    "mean_error": float(m["mean_error"].mean()),
+                    "error_diff": float(d.mean()),
+                    "error_diff_low": lo,
+                    "error_diff_high": hi,
+                    "lost_rate": float(m["lost"].astype(bool).mean()),
+                }
+            )
+    return pd.DataFrame(out, columns=CONFIG_SUMMARY_COLUMNS)
+
+
+_DEPTH = ("plan_depth", "max_depth", "root_actions", "frac_depth1")
+
+
+def paired_configs(runs: pd.DataFrame, model: str, a: str, b: str) -> Paired:
+    """d = mean location error of configuration ``a`` − that of ``b`` on ``model``, paired
+    over runs: mean, 95% t interval (:func:`cluster_mean_ci` with one value per run), its
+    standard error and degrees of freedom (no bootstrap: ``boot_*`` are NaN)."""
+    g = runs[runs["model"] == model]
+    wide = g.pivot(index="run", columns="config", values="mean_error")
+    for name, c in (("a", a), ("b", b)):
+        if c not in wide.columns:
+            raise ValueError(f"{name}: {c!r} has no runs on {model!r}")
+    d = (wide[a] - wide[b]).dropna().to_numpy(float)
+    ci = cluster_mean_ci(d, np.arange(d.size))
+    if ci is None:
+        raise ValueError(f"{a} − {b} on {model!r}: {d.size} paired run(s) (allowed: at least 2)")
+    return Paired(float(d.mean()), ci.low, ci.high, int(d.size), ci.se, ci.df, ci.df + 1)
+
+
+def prob_improvement(a: np.ndarray, b: np.ndarray) -> tuple[float, float, float]:
+    r"""Probability of improvement of a over b (lower is better) over paired runs, as rliable
+    defines it: :math:`P = \frac1n \sum_r [1(a_r < b_r) + \tfrac12 1(a_r = b_r)]`, with the
+    95% t interval of that mean over runs, clipped to [0, 1]. Fewer than 2 runs: NaN CI."""
+    a, b = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if a.shape != b.shape or a.ndim != 1 or a.size == 0:
+        raise ValueError(f"a and b must be 1-D of one length >= 1, got {a.shape} and {b.shape}")
+    s = (a < b).astype(float) + 0.5 * (a == b)
+    p = float(s.mean())
+    if s.size < 2:
+        return p, float("nan"), float("nan")
+    ci = cluster_mean_ci(s, np.arange(s.size))
+    return p, max(0.0, ci.low), min(1.0, ci.high)
+
+
+#: per (model, budget, family) of the confirmatory run (:func:`ladder`)
+LADDER_COLUMNS = [
+    "model",
+    "budget_ms",
+    "family",
+    "config",
+    "plan_ms",
+    "work_per_step",
+    "within_budget",
+    "mean_error",
+    "diff_mc",
+    "diff_mc_low",
+    "diff_mc_high",
+    "p_improve",
+    "p_improve_low",
+    "p_improve_high",
+    "diff_nbo",
+    "diff_nbo_low",
+    "diff_nbo_high",
+]
+
+
+def ladder(
+    runs: pd.DataFrame,
+    summary: pd.DataFrame,
+    chosen: Mapping[str, Mapping[str, Mapping[str, Any]]],
+    budgets_ms: Sequence[float],
+    reference: str = "rsmhp",
+) -> pd.DataFrame:
+    """Per model, budget and family (:data:`LADDER_COLUMNS`): the tuned configuration
+    (``chosen[model][budget text][family]``, a :class:`rsmhp.protocol.Configuration`), its
+    interleaved time and work per step against the budget (``within_budget`` on this run's
+    times), its mean error, the paired difference with the ``reference`` family's member at
+    the same budget (t CI over runs) with the probability of improvement over it
+    (:func:`prob_improvement`), and the paired difference with NBO (from ``summary``,
+    :func:`summarize_configs`)."""
+    s = summary.set_index(["model", "config"])
+    out = []
+    for model, per in chosen.items():
+        g = runs[runs["model"] == model]
+        wide = g.pivot(index="run", columns="config", values="mean_error")
+        for b in budgets_ms:
+            fams = per.get(f"{float(b):g}", {})
+            ref = fams.get(reference)
+            for family, c in fams.items():
+                row = s.loc[(model, c.name)]
+                rec = {
+                    "model": model,
+                    "budget_ms": float(b),
+                    "family": family,
+                    "config": c.name,
+                    "plan_ms": float(row["plan_ms"]),
+                    "work_per_step": float(row["work_per_step"]),
+                    "within_budget": bool(row["plan_ms"] <= float(b)),
+                    "mean_error": float(row["mean_error"]),
+                    "diff_nbo": float(row["error_diff"]),
+                    "diff_nbo_low": float(row["error_diff_low"]),
+                    "diff_nbo_high": float(row["error_diff_high"]),
+                }
+                nan = float("nan")
+                if ref is not None and ref.name != c.name:
+                    d = paired_configs(runs, model, c.name, ref.name)
+                    p = prob_improvement(wide[c.name].to_numpy(), wide[ref.name].to_numpy())
+                    rec.update(diff_mc=d.mean, diff_mc_low=d.low, diff_mc_high=d.high)
+                    rec.update(p_improve=p[0], p_improve_low=p[1], p_improve_high=p[2])
+                elif ref is not None:  # the reference itself
+                    rec.update(diff_mc=0.0, diff_mc_low=0.0, diff_mc_high=0.0)
+                    rec.update(p_improve=0.5, p_improve_low=nan, p_improve_high=nan)
+                else:
+                    rec.update(diff_mc=nan, diff_mc_low=nan, diff_mc_high=nan)
+                    rec.update(p_improve=nan, p_improve_low=nan, p_improve_high=nan)
+                out.append(rec)
+    return pd.DataFrame(out, columns=LADDER_COLUMNS)

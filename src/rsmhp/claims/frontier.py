@@ -315,3 +315,150 @@ def frontier_claims(
     for model in dict.fromkeys(summary["model"]):
         out += _model_claims(model, runs, regret, summary, check, members, cfg, seed, n_boot)
     return out
+
+
+# ------------------------------------------------------------------------ the protocol
+
+#: the tests a preregistered FR claim may use
+CONFIRM_TESTS = ("superiority", "non-inferiority")
+
+
+def confirm_rule(test: str, a: str, b: str, budget_ms: float, margin_m: float) -> Rule:
+    """The rule of a preregistered FR claim: d = closed-loop mean location error of the tuned
+    member ``a`` − that of ``b`` at ``budget_ms`` per step, paired over runs (95% t
+    interval). ``superiority``: equivalent inside ±margin, supported below 0, not supported
+    above 0; ``non-inferiority``: supported below +margin, not supported above it."""
+    basis = (
+        f"d = closed-loop mean location error of {a} − {b}, the tuned members at "
+        f"{param_text(budget_ms)} ms per step, paired over runs (m; 95% t interval)"
+    )
+    text = f"{param_text(margin_m)} m"
+    if test == "superiority":
+        return ci_side(KEY, 0.0, claimed="below", basis=basis, margin=margin_m, margin_text=text)
+    if test == "non-inferiority":
+        return non_inferior(KEY, margin_m, margin_text=text, basis=basis)
+    raise ValueError(f"test: {test!r} (allowed: {', '.join(CONFIRM_TESTS)})")
+
+
+def _label(families: Mapping[str, str], family: str) -> str:
+    return families.get(family, family)
+
+
+def confirm_claims(
+    runs: pd.DataFrame,
+    summary: pd.DataFrame,
+    lad: pd.DataFrame,
+    prereg: Mapping[str, Any],
+    chosen: Mapping[str, Mapping[str, Mapping[str, Any]]],
+    prereg_sha: str,
+) -> list[Claim]:
+    """The preregistered FR claims (``prereg["claims"]``: id -> family, against, test,
+    margin_m) on every model of ``prereg["models"]`` at its headline budget, from the
+    confirmatory run: ``runs`` (:data:`rsmhp.experiments.frontier.CONFIG_RUN_COLUMNS`),
+    ``summary`` (:func:`rsmhp.analysis.frontier.summarize_configs`), ``lad``
+    (:func:`rsmhp.analysis.frontier.ladder`), ``chosen`` (model -> budget text -> family ->
+    :class:`rsmhp.protocol.Configuration`). Each claim names the preregistration (its
+    sha256) in its rule; a member over the budget on this run's times, and a budget of the
+    ladder where the difference lies on the other side, are contrary evidence. Claims whose
+    families have no member at the headline budget are left out and said so."""
+    from rsmhp.analysis.frontier import paired_configs, prob_improvement
+
+    labels = {c.family: c.family_label for c in registry.families()}
+    b = float(prereg["headline_budget_ms"])
+    out: list[Claim] = []
+    s = summary.set_index(["model", "config"])
+    for model in prereg["models"]:
+        per = chosen.get(model, {}).get(f"{b:g}", {})
+        wide = runs[runs["model"] == model].pivot(
+            index="run", columns="config", values="mean_error"
+        )
+        for cid, spec in prereg["claims"].items():
+            fam, ref = spec["family"], spec["against"]
+            if fam not in per or ref not in per:
+                continue
+            a_cfg, b_cfg = per[fam], per[ref]
+            d = paired_configs(runs, model, a_cfg.name, b_cfg.name)
+            margin = float(spec["margin_m"])
+            rule = confirm_rule(spec["test"], a_cfg.label(), b_cfg.label(), b, margin)
+            verdict = rule.verdict(paired_facts(d))
+            p = (
+                _p_side(d, verdict, margin)
+                if spec["test"] == "superiority"
+                else _p_noninferior(d, verdict, margin)
+            )
+            pi = prob_improvement(wide[a_cfg.name].to_numpy(), wide[b_cfg.name].to_numpy())
+            ra, rb = s.loc[(model, a_cfg.name)], s.loc[(model, b_cfg.name)]
+            contrary = []
+            for name, r in ((a_cfg.label(), ra), (b_cfg.label(), rb)):
+                if float(r["plan_ms"]) > b:
+                    contrary.append(
+                        f"{name} took {fmt(float(r['plan_ms']), 3)} ms, over the budget"
+                    )
+            other = lad[(lad["model"] == model) & (lad["family"] == fam) & (lad["budget_ms"] != b)]
+            for r in other.itertuples(index=False):
+                if spec["test"] == "superiority" and r.diff_mc_low > 0:
+                    contrary.append(
+                        f"at {param_text(r.budget_ms)} ms it tracks worse: "
+                        f"{fmt(r.diff_mc, 3, True)} m "
+                        f"{fmt_ci(r.diff_mc_low, r.diff_mc_high, 3, True)}"
+                    )
+                if spec["test"] == "non-inferiority" and r.diff_mc_low > margin:
+                    contrary.append(
+                        f"at {param_text(r.budget_ms)} ms it is worse by more than the margin: "
+                        f"{fmt(r.diff_mc, 3, True)} m"
+                    )
+            depth = ""
+            if a_cfg.family == "dpw":
+                depth = (
+                    f"; the tree search's plans follow its tree for "
+                    f"{fmt(float(ra['plan_depth']), 3)} of H steps on average (deepest node "
+                    f"{fmt(float(ra['max_depth']), 3)}, {fmt(float(ra['root_actions']), 3)} root "
+                    f"actions, {fmt(100 * float(ra['frac_depth1']), 3)}% of simulations leave "
+                    "the tree at depth 1)"
+                )
+            claim_text = (
+                f"On '{model}', at {param_text(b)} ms of planning per step, the tuned "
+                f"{_label(labels, fam)} "
+                + (
+                    f"tracks better than the tuned {_label(labels, ref)} (lower closed-loop error)"
+                    if spec["test"] == "superiority"
+                    else f"tracks as well as the tuned {_label(labels, ref)}, up to "
+                    f"{param_text(margin)} m of closed-loop error"
+                )
+            )
+            out.append(
+                Claim(
+                    f"{cid}-{model}",
+                    claim_text,
+                    "Beyond the paper (its UAV study compares NBO, RS-MHP and pruning only): "
+                    + str(spec.get("why", "")),
+                    KeyNumber(
+                        f"error {a_cfg.label()} − {b_cfg.label()}, paired mean",
+                        float(d.mean),
+                        float(d.low),
+                        float(d.high),
+                        unit="m",
+                        reproducible="statistical",
+                        digits=3,
+                        null=0.0 if spec["test"] == "superiority" else margin,
+                        p_value=p,
+                    ),
+                    verdict,
+                    rule.text() + f" (preregistered, sha256 {prereg_sha[:12]})",
+                    measured=(
+                        f"{d.n} paired runs on the confirmatory stream; mean error "
+                        f"{fmt(float(ra['mean_error']))} vs {fmt(float(rb['mean_error']))} m; "
+                        f"probability of improvement {fmt(pi[0], 3)} "
+                        f"{fmt_ci(pi[1], pi[2], 3)}; {a_cfg.label()} "
+                        f"{fmt(float(ra['plan_ms']), 3)} ms and "
+                        f"{fmt(float(ra['work_per_step']), 3)} model steps per step, "
+                        f"{b_cfg.label()} {fmt(float(rb['plan_ms']), 3)} ms and "
+                        f"{fmt(float(rb['work_per_step']), 3)} model steps (interleaved timing, "
+                        f"median){depth}"
+                    ),
+                    part="beyond",
+                    setup=f"UAV '{model}', confirmatory stream, {param_text(b)} ms per step",
+                    contrary="; ".join(contrary),
+                )
+            )
+    return out

@@ -7,6 +7,13 @@ line through its members in order of compute, in the palette's family colour, wi
 bootstrap CI of every point as a vertical bar; NBO is the reference line at 0; the planning
 budget of the equal-compute claims (``decisions.frontier.budget.ms_per_step``), when given,
 is a dotted vertical line.
+
+``dec_confirm`` (:func:`confirm_figure`), the confirmatory run of the protocol: columns are
+model variants; each family's tuned members along the budget ladder as one line; rows: closed-
+loop mean location error minus NBO's (m, 95% t CIs over runs) against the interleaved planning
+milliseconds per step, the same against model steps per planning step (machine-independent),
+and the probability of improvement over the Monte-Carlo member at the same budget (95% t CIs)
+against the budget.
 """
 
 from __future__ import annotations
@@ -20,7 +27,10 @@ from rsmhp.figures import theme
 from rsmhp.palette import method_colour
 from rsmhp.uav import methods
 
-__all__ = ["FIGURES", "frontier_figure"]
+__all__ = ["CONFIRM_FIGURES", "FIGURES", "confirm_figure", "frontier_figure"]
+
+#: the confirmatory run's figure (:func:`confirm_figure`)
+CONFIRM_FIGURES = ["dec_confirm"]
 
 FIGURES = ["dec_frontier"]
 
@@ -91,6 +101,58 @@ def frontier_figure(summary: pd.DataFrame, budget_ms: float | None = None) -> pl
                 ax.set_xlabel(xlabel)
             if j == 0:
                 ax.set_ylabel(label)
+    axes[0, -1].legend(fontsize="small", loc="best")
+    fig.tight_layout()
+    return fig
+
+
+def confirm_figure(lad: pd.DataFrame) -> plt.Figure:
+    """The confirmatory ladder (:func:`rsmhp.analysis.frontier.ladder`), see the module
+    docstring."""
+    theme()
+    models = list(dict.fromkeys(lad["model"]))
+    if not models:
+        raise ValueError("ladder is empty")
+    fams = {c.family: c for c in methods.families()}
+    rows = (
+        ("plan_ms", "diff_nbo", "error − NBO's (m)", "planning ms per step (interleaved)"),
+        ("work_per_step", "diff_nbo", "error − NBO's (m)", "model steps per planning step"),
+        ("budget_ms", "p_improve", "P(improvement over Monte Carlo)", "budget (ms per step)"),
+    )
+    fig, axes = plt.subplots(
+        len(rows), len(models), figsize=(4.8 * len(models), 9.6), squeeze=False
+    )
+    for j, model in enumerate(models):
+        g = lad[lad["model"] == model]
+        for i, (xcol, ycol, ylabel, xlabel) in enumerate(rows):
+            ax = axes[i, j]
+            ref = 0.5 if ycol == "p_improve" else 0.0
+            ax.axhline(ref, color=method_colour("nbo"), lw=1.0, ls="--")
+            for fam, f in g.groupby("family", sort=False):
+                f = f.sort_values("budget_ms")
+                y = f[ycol].to_numpy(float)
+                lo = np.nan_to_num(y - f[f"{ycol}_low"].to_numpy(float))
+                hi = np.nan_to_num(f[f"{ycol}_high"].to_numpy(float) - y)
+                ax.errorbar(
+                    f[xcol],
+                    y,
+                    yerr=np.vstack([lo, hi]),
+                    color=fams[fam].colour if fam in fams else "0.5",
+                    marker="o",
+                    ms=4,
+                    capsize=2,
+                    lw=1.3,
+                    label=fams[fam].family_label if fam in fams else fam,
+                )
+            ax.set_xscale("log")
+            ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+            ax.xaxis.set_minor_formatter(NullFormatter())
+            ax.set_xlabel(xlabel)
+            if i == 0:
+                ax.set_title(model)
+            if j == 0:
+                ax.set_ylabel(ylabel)
     axes[0, -1].legend(fontsize="small", loc="best")
     fig.tight_layout()
     return fig

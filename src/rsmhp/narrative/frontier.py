@@ -197,8 +197,10 @@ def _appendix(cfg: Mapping[str, Any], tables: Mapping[str, str], horizon: int) -
             f"Tree search constants (`rsmhp.uav.methods.tree_search`, chosen before any run): "
             f"UCB exploration c = {C_UCB} on per-step rewards −tr P / tr P̂ of the root, action "
             f"widening k_a = {K_A:g}, α_a = {ALPHA_A}, observation widening k_o = {K_O:g}, "
-            f"α_o = {ALPHA_O}; the first action at each depth is the warm start's, rollouts "
-            "follow the warm start; the plan follows the most visited actions.",
+            f"α_o = {ALPHA_O} (members may set their own: `_ka`, `_ko`, `_ao`, `_c` in the "
+            "name); the first action at each depth is the warm start's, the second the "
+            "pursuit policy's (steer to the estimate, close the range); rollouts and the plan "
+            "beyond the most visited path follow the pursuit policy.",
         ]
     )
 
@@ -212,16 +214,276 @@ def frontier_section(
     seed: int,
     horizon: int,
 ) -> Section:
-    """The equal-compute study's report section (order 32); ``cfg`` is
-    ``decisions.frontier``, ``horizon`` the planners' H (``uav.planner.horizon``)."""
+    """The exploratory equal-compute design's report section (order 33, only with
+    ``decisions.frontier.exploratory``); ``cfg`` is ``decisions.frontier``, ``horizon`` the
+    planners' H (``uav.planner.horizon``). Its comparisons FR-1..3 were chosen on the data
+    that judge them: they are printed as exploratory findings, never as claims of the
+    ledger (the ledger's FR claims come from the confirmatory run)."""
     claims = frontier_claims(runs, regret, summary, cfg, seed)
-    body = "\n".join([_setting(cfg, summary), "", _findings(claims, summary), "", *_FIGURE])
+    body = "\n".join(
+        [
+            "**Exploratory design** (published up to 76a0c01; its comparisons were chosen on "
+            "the data that judge them, so nothing here is counted). " + _setting(cfg, summary),
+            "",
+            "Exploratory comparisons (not claims): " + _findings(claims, summary),
+            "",
+            *_FIGURE,
+        ]
+    )
     return Section(
-        key="decisions_frontier",
-        title="Planners at equal compute",
-        order=32,
+        key="decisions_frontier_exploratory",
+        title="Planners at equal compute: the exploratory design",
+        order=33,
         body=body,
-        claims=claims,
+        claims=[],
         figures=list(FIGURES),
         appendix=_appendix(cfg, tables, horizon),
+    )
+
+
+# ------------------------------------------------------------------------ the protocol
+
+#: table stems of the confirmatory section (rule frontier_confirm_summary)
+CONFIRM_TABLES = ("dec_confirm", "dec_confirm_ladder", "dec_confirm_tuning")
+
+
+def _config_table(summary: pd.DataFrame) -> str:
+    t = pd.DataFrame(
+        {
+            "model": summary["model"],
+            "configuration": summary["config"],
+            "ms/step": summary["plan_ms"],
+            "ms range": ci_cells(summary["plan_lo_ms"], summary["plan_hi_ms"]),
+            "model steps/step": summary["work_per_step"].round(0),
+            "iterations": summary["mean_nit"],
+            "converged %": (100 * summary["converged_rate"]).round(1),
+            "tree depth of plan": summary["plan_depth"],
+            "deepest node": summary["max_depth"],
+            "root actions": summary["root_actions"],
+            "runs": summary["runs"].astype(int),
+            "error (m)": summary["mean_error"],
+            "− NBO (m)": summary["error_diff"],
+            "95% CI (m)": ci_cells(
+                summary["error_diff_low"], summary["error_diff_high"], signed=True
+            ),
+            "lost %": (100 * summary["lost_rate"]).round(1),
+        }
+    )
+    return markdown_table(t, digits=3, missing="—", signed=("− NBO (m)",))
+
+
+def _ladder_table(lad: pd.DataFrame) -> str:
+    labels = {c.family: c.family_label for c in registry.families()}
+    t = pd.DataFrame(
+        {
+            "model": lad["model"],
+            "budget (ms)": lad["budget_ms"],
+            "family": lad["family"].map(lambda f: labels.get(f, f)),
+            "tuned configuration": lad["config"],
+            "ms/step": lad["plan_ms"],
+            "within": ["yes" if w else "no" for w in lad["within_budget"]],
+            "model steps/step": lad["work_per_step"].round(0),
+            "error (m)": lad["mean_error"],
+            "− Monte Carlo (m)": lad["diff_mc"],
+            "95% CI": ci_cells(lad["diff_mc_low"], lad["diff_mc_high"], signed=True),
+            "P(improvement)": lad["p_improve"],
+            "95% CI ": ci_cells(lad["p_improve_low"], lad["p_improve_high"]),
+        }
+    )
+    return markdown_table(t, digits=3, missing="—", signed=("− Monte Carlo (m)",))
+
+
+def _tuning_table(tuned: Mapping[str, Any]) -> str:
+    labels = {c.family: c.family_label for c in registry.families()}
+    rows = []
+    for model, per in tuned.get("chosen", {}).items():
+        for b, fams in per.items():
+            for fam, e in fams.items():
+                t = e.get("tuning", {})
+                rows.append(
+                    {
+                        "model": model,
+                        "budget (ms)": float(b),
+                        "family": labels.get(fam, fam),
+                        "member": e["member"],
+                        "maxiter": "—" if e.get("maxiter") is None else int(e["maxiter"]),
+                        "restarts": int(e.get("restarts", 0)),
+                        "tuning ms/step": t.get("plan_ms", float("nan")),
+                        "tuning error (m)": t.get("mean_error", float("nan")),
+                        "candidates within budget": t.get("candidates_within_budget", 0),
+                    }
+                )
+    if not rows:
+        return "(no tuned configurations)"
+    return markdown_table(pd.DataFrame(rows), digits=4, missing="—")
+
+
+def confirm_tables(
+    summary: pd.DataFrame, lad: pd.DataFrame, tuned: Mapping[str, Any]
+) -> dict[str, str]:
+    """Markdown tables of the confirmatory section: ``dec_confirm`` (every configuration:
+    both compute units, optimiser and depth statistics, error and its difference with NBO),
+    ``dec_confirm_ladder`` (per model, budget and family: the tuned member against Monte
+    Carlo's) and ``dec_confirm_tuning`` (what the tuning chose, with its tuning numbers)."""
+    return {
+        "dec_confirm": _config_table(summary),
+        "dec_confirm_ladder": _ladder_table(lad),
+        "dec_confirm_tuning": _tuning_table(tuned),
+    }
+
+
+def _best_per_budget(lad: pd.DataFrame) -> str:
+    labels = {c.family: c.family_label for c in registry.families()}
+    out = []
+    for model, g in lad.groupby("model", sort=False):
+        parts = []
+        for b, f in g.groupby("budget_ms", sort=True):
+            best = f.loc[f["mean_error"].idxmin()]
+            clear = f[(f["diff_mc_high"] < 0)]
+            parts.append(
+                f"{param_text(float(b))} ms: {labels.get(best['family'], best['family'])} "
+                f"({fmt(float(best['mean_error']), 3)} m"
+                + (
+                    f"; below Monte Carlo's CI-wise: "
+                    f"{', '.join(labels.get(x, x) for x in clear['family'])})"
+                    if len(clear)
+                    else "; no family below Monte Carlo CI-wise)"
+                )
+            )
+        out.append(f"'{model}': " + "; ".join(parts))
+    return (
+        "Lowest mean closed-loop error per budget (descriptive, not a claim): "
+        + ". ".join(out)
+        + "."
+    )
+
+
+def _exploratory_table(exploratory: Sequence[Mapping[str, Any]]) -> str:
+    if not exploratory:
+        return "(none)"
+    t = pd.DataFrame(
+        {
+            "claim": [c["id"] for c in exploratory],
+            "key number": [
+                f"{fmt(c['key']['value'], 3, True)} {c['key'].get('unit', '')}".strip()
+                + (
+                    f" {fmt_ci(c['key']['ci_low'], c['key']['ci_high'], 3, True)}"
+                    if c["key"].get("ci_low") is not None
+                    else ""
+                )
+                for c in exploratory
+            ],
+            "verdict then": [c["verdict"] for c in exploratory],
+        }
+    )
+    return markdown_table(t)
+
+
+def confirm_section(
+    summary: pd.DataFrame,
+    lad: pd.DataFrame,
+    claims: Sequence[Claim],
+    tables: Mapping[str, str],
+    prereg: Mapping[str, Any],
+    prereg_meta: Mapping[str, str],
+    tuned: Mapping[str, Any],
+    exploratory: Sequence[Mapping[str, Any]],
+) -> Section:
+    """The equal-compute study's report section (order 32) from the confirmatory run of the
+    protocol (:mod:`rsmhp.protocol`): ``prereg`` the preregistration's content and
+    ``prereg_meta`` its path, sha256 and commit; ``tuned`` the tuned file; ``exploratory``
+    the FR and HZ claims published at 76a0c01 (kept, not counted)."""
+    prov = tuned.get("provenance", {})
+    runs = prereg["runs"]
+    per = runs if isinstance(runs, Mapping) else dict.fromkeys(prereg["models"], runs)
+    runs_text = ", ".join(f"{per[m]} on '{m}'" for m in prereg["models"])
+    setting = (
+        "A comparison at equal compute in three steps (`rsmhp.protocol`). **Tuning**, on a seed "
+        f"stream of its own: {prov.get('candidates', '?')} candidate configurations "
+        "(every sampled-cost member with every optimiser budget: iterations and restarts; "
+        "tree searches with several widening and UCB constants) in "
+        f"{prov.get('runs per candidate', '?')} closed-loop runs each and in an interleaved "
+        "timing; per model, family and budget the rule picks the lowest tuning error within "
+        f"the budget ({prov.get('date (UTC)', '?')}, commit "
+        f"{str(prov.get('commit', '?'))[:10]}; `config/tuned.yaml`). **Preregistration**: "
+        f"`{prereg_meta['path']}` (sha256 {prereg_meta['sha256'][:12]}, commit "
+        f"{prereg_meta['commit'][:10]}) fixes the members, budgets "
+        f"({', '.join(param_text(float(b)) for b in prereg['budgets_ms'])} ms of planning per "
+        f"step, wall clock on the tuning machine; the claims at "
+        f"{param_text(float(prereg['headline_budget_ms']))} ms), the rules and the run counts "
+        f"({runs_text}; {prereg.get('power_text', '')}) before the **confirmatory run**, on a "
+        "third stream, which gives every number below. Times are remeasured here "
+        "(interleaved, round robin, a job holding the cores); model steps (one step of one "
+        "covariance recursion) do not depend on the machine."
+    )
+    fr = [c for c in claims if c.id.startswith("FR-")]
+    found = "; ".join(
+        f"{c.id} {fmt(c.key.value, 3, True)} m {fmt_ci(c.key.ci_low, c.key.ci_high, 3, True)} "
+        f"({c.verdict})"
+        for c in fr
+    )
+    body = "\n".join(
+        [
+            setting,
+            "",
+            (f"Preregistered claims (before Holm's correction): {found}. " if fr else "")
+            + _best_per_budget(lad),
+            "",
+            "![Confirmatory ladder](figures/dec_confirm.png)",
+            "",
+            "*Tuned members along the budget ladder, one line per family: closed-loop error − "
+            "NBO's against planning ms per step (top) and model steps per step (middle); "
+            "probability of improvement over the Monte-Carlo member at the same budget "
+            "(bottom); bars: 95% t CIs over runs.*",
+        ]
+    )
+    dpw = summary[summary["family"] == "dpw"]
+    appendix = "\n".join(
+        [
+            "Every configuration of the confirmatory run: interleaved planning ms per step "
+            "(median; range over passes), model steps per step, optimiser iterations and "
+            "converged share (sampled-cost planners), the tree search's depth statistics "
+            "(steps of the plan taken from the tree, deepest node, root actions; means over "
+            "steps and runs), mean error and its difference with NBO (95% t CI over runs).",
+            "",
+            tables["dec_confirm"],
+            "",
+            "The ladder: per model, budget and family the tuned configuration against the "
+            "Monte-Carlo member at the same budget (difference and probability of "
+            "improvement, 95% t CIs over runs; within: its time on this run within the "
+            "budget).",
+            "",
+            tables["dec_confirm_ladder"],
+            "",
+            "What the tuning chose (tuning stream; the numbers the rule saw):",
+            "",
+            tables["dec_confirm_tuning"],
+            "",
+            (
+                f"Tree search: {len(dpw)} tuned configurations; their plans take "
+                f"{fmt(float(dpw['plan_depth'].min()), 3)} to "
+                f"{fmt(float(dpw['plan_depth'].max()), 3)} of their steps from the tree "
+                f"(deepest nodes {fmt(float(dpw['max_depth'].min()), 3)} to "
+                f"{fmt(float(dpw['max_depth'].max()), 3)}), the rest from the pursuit "
+                "rollout policy (steer to the estimate, close the range). Constants in the "
+                "member names (`_ka`, `_ko`, `_ao`, `_c`: action and observation widening, "
+                "UCB; defaults c = 0.5, k_a = 4, α_a = 0.25, k_o = 4, α_o = 0.25)."
+                if len(dpw)
+                else "No tree search was tuned into the ladder."
+            ),
+            "",
+            "Exploratory results published at 76a0c01 (chosen and judged on one stream; "
+            "kept for the record, not counted):",
+            "",
+            _exploratory_table(exploratory),
+        ]
+    )
+    return Section(
+        key="decisions_frontier",
+        title="Planners at equal compute (confirmatory)",
+        order=32,
+        body=body,
+        claims=list(claims),
+        figures=["dec_confirm"],
+        appendix=appendix,
     )

@@ -1,0 +1,21 @@
+"""Rule frontier_confirm: closed-loop runs of the preregistered configurations on one model
+variant, on the confirmatory stream."""
+
+from rsmhp.experiments.frontier import run_configurations
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+from rsmhp.protocol import Configuration, stream_seed
+
+with rule_logging(snakemake):
+    p = snakemake.params
+    configs = [Configuration.from_spec(c) for c in p.plan]
+    table = run_configurations(
+        p.uav,
+        p.models,
+        snakemake.wildcards.model,
+        configs,
+        range(int(p.runs)),
+        stream_seed(p.seed, "confirm"),
+        p.track_loss_error,
+    )
+    write_csv(table, snakemake.output[0])

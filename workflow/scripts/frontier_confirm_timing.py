@@ -1,0 +1,20 @@
+"""Rule frontier_confirm_timing: interleaved wall-clock timing of the preregistered
+configurations on one model variant, at belief states of the confirmatory stream."""
+
+from rsmhp.experiments.frontier import time_configurations
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+from rsmhp.protocol import Configuration, stream_seed
+
+with rule_logging(snakemake):
+    p = snakemake.params
+    configs = [Configuration.from_spec(c) for c in p.plan]
+    table = time_configurations(
+        p.uav,
+        p.models,
+        snakemake.wildcards.model,
+        configs,
+        p.timing,
+        stream_seed(p.seed, "confirm"),
+    )
+    write_csv(table, snakemake.output[0])
