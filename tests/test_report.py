@@ -351,3 +351,26 @@ def test_verify_fails_when_a_run_loses_the_statements(tmp_path):
     run.write_text(json.dumps(data))
     ok, text = vfy.verify(ref, run)
     assert not ok and "S1: supported -> -" in text
+
+
+def test_verify_refuses_runs_judged_under_another_preregistration(tmp_path, capsys):
+    """claims.json records the preregistration (path, sha256, commit) its confirmatory claims
+    were judged under; verify compares only runs of the same one (exit 2 otherwise)."""
+    claims = [_claim("FR-1-m", "supported", -0.3, -0.5, -0.1)]
+
+    def write(name, pre):
+        path = _file(tmp_path / name, claims)
+        data = json.loads(path.read_text())
+        data["preregistration"] = pre
+        path.write_text(json.dumps(data))
+        return path
+
+    pre = {"path": "config/preregistration.yaml", "sha256": "a" * 64, "commit": "c" * 40}
+    ref, same = write("ref.json", pre), write("same.json", pre)
+    assert vfy.main(["--reference", str(ref), "--run", str(same)]) == 0
+    other = write("other.json", {**pre, "sha256": "b" * 64})
+    assert vfy.main(["--reference", str(ref), "--run", str(other)]) == 2
+    err = capsys.readouterr().err
+    assert "preregistration sha256 " + "b" * 64 in err and "a" * 64 in err
+    none = write("none.json", {})
+    assert vfy.main(["--reference", str(ref), "--run", str(none)]) == 2

@@ -163,7 +163,8 @@ def test_workflow_runs_through_slurm_like_locally_and_survives_scancel(cluster, 
 RULE_MEM = {
     "horizon_lqg_estimators", "horizon_lqg_regret", "horizon_summary", "horizon_uav",
     "horizon_uav_closed", "horizon_figures", "horizon_recording", "lqg_summary",
-    "lqg_figures", "lqg_recording", "lqg_linear_cost",
+    "lqg_figures", "lqg_recording", "lqg_linear_cost", "horizon_optimiser",
+    "horizon_optimiser_summary", "horizon_optimiser_figures",
 }  # fmt: skip
 
 

@@ -353,6 +353,51 @@ def test_frontier_outputs(run_j2, tiny):
     for table in ("dec_frontier", "dec_frontier_budget"):
         text = (run_j2 / f"results/tables/{table}.md").read_text()
         assert text.strip() and text.strip() in appendix
+    # the exploratory design (tiny: exploratory: true) has its section, never claims
+    assert "## Planners at equal compute: the exploratory design" in report
+
+
+def test_confirm_outputs(run_j2, tiny):
+    """The protocol's confirmatory run in the default target: the preregistered
+    configurations' closed-loop runs on the confirm stream and their interleaved timing, the
+    summary and ladder, claims FR-1..3 judged under the preregistration (its sha256 in each
+    rule and in claims.json), the figure and tables, the 76a0c01 exploratory claims kept."""
+    from rsmhp.protocol import Preregistration, file_sha256, stream_seed, tuned_configurations
+
+    cfg = tiny["decisions"]["frontier"]["confirm"]
+    pre = Preregistration.load(ROOT / cfg["preregistration"], ROOT / cfg["tuned"])
+    tuned = yaml.safe_load((ROOT / cfg["tuned"]).read_text())
+    for model in pre.doc["models"]:
+        runs = pd.read_csv(run_j2 / f"results/decisions/confirm/{model}.csv")
+        want = {c.name for c in pre.configurations(tuned, model)}
+        assert set(runs["config"]) == want and len(runs) == len(want) * pre.runs(model)
+        timing = pd.read_csv(run_j2 / f"results/decisions/confirm/timing/{model}.csv")
+        assert set(timing["config"]) == want and (timing["ms"] > 0).all()
+        # the confirm stream: NBO's runs are not the exploratory frontier's (another seed)
+        explo = pd.read_csv(run_j2 / f"results/decisions/frontier/{model}.csv")
+        nbo_c = runs[runs["config"] == "nbo"].set_index("run")["mean_error"]
+        nbo_e = explo[explo["method"] == "nbo"].set_index("run")["mean_error"]
+        common = nbo_c.index.intersection(nbo_e.index)
+        assert len(common) and (nbo_c[common] != nbo_e[common]).all()
+        assert stream_seed(tiny["seed"], "confirm") != tiny["seed"]
+        per = tuned_configurations(tuned, model)
+        lad = pd.read_csv(run_j2 / "results/decisions/confirm_ladder.csv")
+        assert len(lad[lad["model"] == model]) == sum(
+            len(per.get(f"{float(b):g}", {})) for b in pre.doc["budgets_ms"]
+        )
+    data = json.loads((run_j2 / "results/paper/claims.json").read_text())
+    sha = file_sha256(ROOT / cfg["preregistration"])
+    assert data["preregistration"]["sha256"] == sha
+    fr = [c for c in data["claims"] if c["id"].startswith("FR-")]
+    assert fr and all(f"sha256 {sha[:12]}" in c["rule"] for c in fr)
+    assert all(c["key"]["p_value"] is not None and c["key"]["p_holm"] is not None for c in fr)
+    report = (run_j2 / "results/paper/replication.md").read_text()
+    assert "## Planners at equal compute (confirmatory)" in report
+    assert "](figures/dec_confirm.png)" in report
+    appendix = (run_j2 / "results/paper/appendix.md").read_text()
+    assert "76a0c01" in appendix
+    for table in ("dec_confirm", "dec_confirm_ladder", "dec_confirm_tuning"):
+        assert (run_j2 / f"results/tables/{table}.md").read_text().strip() in appendix
 
 
 def test_horizon_outputs(run_j2, tiny):
@@ -534,6 +579,9 @@ def test_slurm_profile_plans_every_rule(tmp_path):
     }
     # the default target plans every rule except the six study-level target rules and verify
     targets = {"lqg", "estimators", "uav", "decisions", "frontier", "horizon", "verify"}
+    # ... and the protocol's tuning (its own target, `make tune`) and the exploratory target
+    targets |= {"tune", "frontier_tune", "frontier_tune_timing", "frontier_tune_select"}
+    targets |= {"frontier_exploratory"}
     assert planned == every - targets
     profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
     assert profile["executor"] == "slurm"
@@ -552,7 +600,7 @@ def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, 
     captions = sorted((ROOT / "workflow/report").glob("*.rst"))
     figures = [p.stem for p in (run_j2 / "results/figures").glob("*.png")]
     tables = [p.stem for p in (run_j2 / "results/tables").glob("*.md")]
-    assert len(figures) == 22 and len(tables) == 24
+    assert len(figures) == 24 and len(tables) == 28
     assert {c.stem for c in captions} == set(figures) | {f"table_{t}" for t in tables}
     for name in figures:
         assert f"{name}.png" in html, name

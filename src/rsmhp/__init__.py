@@ -13,7 +13,8 @@ Core (model-independent)
   cost_estimators   uniform and likeliness-weighted averages, NBO
   boxqn             compiled projected L-BFGS over [-1, 1]^n (scipy's budgets and tolerances)
   linear_quadratic  linear-Gaussian systems with quadratic cost and their exact oracles
-  stats             confidence intervals (mean, RMSE, binomial) and log-log slope fits
+  stats             confidence intervals (mean, RMSE, binomial; cluster-t and bootstrap-t
+                    over few clusters), log-log slope fits, Holm's correction, t-test power
   guards            argument checks of the public entry points (ValueError / TypeError naming
                     the argument, the value and what is allowed)
 Models
@@ -30,9 +31,11 @@ Models
                     simulation, recording
 Stages of the pipeline (one module per model and stage)
   experiments       lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon,
-                    horizon_lqg: config -> tidy tables
+                    horizon_lqg, optimiser_split: config -> tidy tables
   analysis          lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon,
-                    horizon_lqg: tables -> statistics
+                    horizon_lqg, optimiser_split: tables -> statistics
+  protocol          the comparison protocol: seed streams (exploratory, tune, confirm),
+                    planner configurations, the tuning rule, the preregistration
   figures           lqg, estimators, uav, decisions, frontier, horizon: seaborn figures (PNG
                     + PDF)
   recording         rerun recordings of sampled trajectory trees

@@ -211,6 +211,11 @@ def _cross_field(config: Mapping[str, Any]) -> list[str]:
         if isinstance(val, float) and not math.isfinite(val):
             problems.append(f"lqg.model.{key}: {val} is not finite")
     problems += _horizon_lqg_problems((config.get("horizon", {}) or {}).get("lqg", {}) or {})
+    # horizon.optimiser: steps inside a run, models, methods, budgets (imported here: no rule
+    # imports this module, so its code digests stay as they are)
+    from rsmhp.experiments.optimiser_split import config_problems as _optimiser_problems
+
+    problems += _optimiser_problems(config)
     problems += _nothing_to_run(config)
     problems += _uav_cross_field(config.get("uav", {}) or {})
     problems += _decisions_cross_field(config)

@@ -1,16 +1,30 @@
 # Equal-compute study of the planners (decisions.frontier): one job per model variant with
 # paired closed-loop runs and open-loop regret of every method and its planning time per step
 # (one thread: the time is the study's measure of compute), then aggregation and the figure.
+import json
+
+from rsmhp.figures.frontier import CONFIRM_FIGURES
 from rsmhp.figures.frontier import FIGURES as FRONTIER_FIGURES
+from rsmhp.narrative.frontier import CONFIRM_TABLES
 from rsmhp.narrative.frontier import TABLES as FRONTIER_TABLES
+from rsmhp.protocol import confirm_plan
 
 FRONTIER = config["decisions"]["frontier"]
 FRONTIER_MODELS = list(FRONTIER["models"])
 FRONTIER_REC = config["decisions"]["recording"]
 FRONTIER_RECORDING = f"results/recordings/dec_{FRONTIER_REC['model']}_planners.rrd"
-if FRONTIER_MODELS:
-    REPORT_SECTIONS["decisions_frontier"] = "results/report/decisions_frontier.json"
+# the exploratory design (published up to 76a0c01): only on request, as a section without claims
+if FRONTIER_MODELS and FRONTIER["exploratory"]:
+    REPORT_SECTIONS["decisions_frontier_exploratory"] = (
+        "results/report/decisions_frontier.json"
+    )
     REPORT_FIGURES.extend(FRONTIER_FIGURES)
+# the confirmatory run: what the committed preregistration and tuned file name (checked here,
+# before any job: a tuned file that is not the preregistered one stops the workflow)
+CONFIRM = confirm_plan(workflow.basedir, FRONTIER)
+if CONFIRM is not None:
+    REPORT_SECTIONS["decisions_frontier"] = "results/report/decisions_confirm.json"
+    REPORT_FIGURES.extend(CONFIRM_FIGURES)
 
 
 wildcard_constraints:
@@ -161,8 +175,8 @@ rule decisions_frontier_recording:
         "../scripts/decisions_frontier_recording.py"
 
 
-rule frontier:
-    """Target: the equal-compute study (tables, section, figure, recording; nothing when no model is configured)."""
+rule frontier_exploratory:
+    """Target: the exploratory equal-compute design published up to 76a0c01 (tables, section, figure, recording)."""
     input:
         rules.decisions_frontier_summary.output if FRONTIER_MODELS else [],
         rules.decisions_frontier_figures.output if FRONTIER_MODELS else [],
@@ -258,3 +272,122 @@ rule tune:
     """Target: the protocol's tuning (not part of the default run): results/tune/tuned.yaml."""
     input:
         rules.frontier_tune_select.output if FRONTIER_MODELS else [],
+
+
+# The confirmatory run (part of the default run): the preregistered configurations of every
+# model on the confirm stream, their interleaved timing, then claims FR-*, tables, figure.
+CONFIRM_MODELS = list(CONFIRM["models"]) if CONFIRM is not None else []
+with open(
+    os.path.join(workflow.basedir, "paper/exploratory/claims_76a0c01.json")
+) as _f:
+    EXPLORATORY_CLAIMS = json.load(_f)["claims"]
+
+
+rule frontier_confirm:
+    """Protocol, confirmatory run, one model variant: closed-loop runs of the preregistered configurations on the confirm stream."""
+    output:
+        "results/decisions/confirm/{model}.csv",
+    log:
+        "results/logs/frontier_confirm/{model}.log",
+    benchmark:
+        "results/benchmarks/frontier_confirm/{model}.tsv"
+    priority: PRIORITY["decisions_frontier"]
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=120,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(config["decisions"]["uav"]["models"]),
+        plan=lambda w: CONFIRM["plans"][w.model],
+        runs=lambda w: CONFIRM["runs"][w.model],
+        track_loss_error=FRONTIER["track_loss_error"],
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/frontier_confirm.py"),
+    script:
+        "../scripts/frontier_confirm.py"
+
+
+rule frontier_confirm_timing:
+    """Protocol, confirmatory run, one model variant: interleaved timing of the preregistered configurations (holds the cores)."""
+    output:
+        "results/decisions/confirm/timing/{model}.csv",
+    log:
+        "results/logs/frontier_confirm_timing/{model}.log",
+    benchmark:
+        "results/benchmarks/frontier_confirm_timing/{model}.tsv"
+    conda:
+        ENV
+    # plans on one thread but holds two: nothing runs beside it on the 2-core machine
+    threads: 2
+    resources:
+        mem_mb=2000,
+        runtime=30,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(config["decisions"]["uav"]["models"]),
+        plan=lambda w: CONFIRM["plans"][w.model],
+        timing=canonical(FRONTIER["confirm"]["timing"]),
+        seed=config["seed"],
+        code=code_digest("workflow/scripts/frontier_confirm_timing.py"),
+    script:
+        "../scripts/frontier_confirm_timing.py"
+
+
+rule frontier_confirm_summary:
+    """Protocol, confirmatory run: per configuration and budget, compute and quality with CIs, claims FR-*, tables and the report section."""
+    input:
+        runs=expand("results/decisions/confirm/{model}.csv", model=CONFIRM_MODELS),
+        timing=expand(
+            "results/decisions/confirm/timing/{model}.csv", model=CONFIRM_MODELS
+        ),
+    output:
+        summary="results/decisions/confirm_summary.csv",
+        ladder="results/decisions/confirm_ladder.csv",
+        tables=table_outputs(CONFIRM_TABLES, "Decision study"),
+        section="results/report/decisions_confirm.json",
+    log:
+        "results/logs/frontier_confirm_summary.log",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        confirm=CONFIRM,
+        timing=canonical(FRONTIER["confirm"]["timing"]),
+        # the FR and HZ claims published at 76a0c01 (exploratory; kept, not counted)
+        exploratory=EXPLORATORY_CLAIMS,
+        code=code_digest("workflow/scripts/frontier_confirm_summary.py"),
+    script:
+        "../scripts/frontier_confirm_summary.py"
+
+
+rule frontier_confirm_figures:
+    """Protocol, confirmatory run: the ladder figure (error against both compute units, probability of improvement)."""
+    input:
+        ladder="results/decisions/confirm_ladder.csv",
+    output:
+        figure_outputs(CONFIRM_FIGURES, "Decision study"),
+    log:
+        "results/logs/frontier_confirm_figures.log",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
+    params:
+        code=code_digest("workflow/scripts/frontier_confirm_figures.py"),
+    script:
+        "../scripts/frontier_confirm_figures.py"
+
+
+rule frontier:
+    """Target: the equal-compute study's confirmatory run (tables, section, figure; nothing without a preregistration)."""
+    input:
+        rules.frontier_confirm_summary.output if CONFIRM_MODELS else [],
+        rules.frontier_confirm_figures.output if CONFIRM_MODELS else [],

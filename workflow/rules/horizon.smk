@@ -4,8 +4,14 @@
 # estimators and decision regret at long horizons against exact oracles; then aggregation,
 # claims and report section, and the figures.
 from rsmhp.figures.horizon import FIGURES as HORIZON_FIGURES
+from rsmhp.figures.optimiser_split import FIGURES as OPTIMISER_FIGURES
 from rsmhp.narrative.horizon import TABLES as HORIZON_TABLES
+from rsmhp.narrative.optimiser_split import TABLES as OPTIMISER_TABLES
+from rsmhp.protocol import stream_seed
 
+# the seed stream every job of the study draws from (horizon.stream: confirm, the stream of
+# the published verdicts; exploratory: the stream of the runs published up to 76a0c01)
+HZ_SEED = stream_seed(config["seed"], config["horizon"]["stream"])
 HZ = config["horizon"]["uav"]
 HZL = config["horizon"]["lqg"]
 HZL_MODEL = pick(config["lqg"]["model"], "x0", "r", "target", "sigma")
@@ -20,6 +26,20 @@ HZ_RECORDING = (
 if HZ_MODELS:
     REPORT_SECTIONS["horizon_uav"] = "results/report/horizon_uav.json"
     REPORT_FIGURES.extend(HORIZON_FIGURES)
+# Optimiser error apart from approximation error (horizon.optimiser): one job per model
+# variant and H (models: default horizon.uav.models), then the summary with its report
+# section (order 34, after the horizon section) and the figure.
+HZO = config["horizon"]["optimiser"]
+HZO_MODELS = list(HZ_MODELS if HZO.get("models") is None else HZO["models"])
+HZO_JOBS = [f"{m}_H{h}" for m in HZO_MODELS for h in HZO["H"]]
+# what one job of the split depends on besides the model, H and the planner
+HZO_KEYS = ("runs", "steps", "methods", "budgets", "polish_starts", "polish_maxiter")
+# each model variant's decisions.uav.models entry (its overrides), for the job of that model
+HZ_VARIANTS = {m["name"]: canonical(m) for m in config["decisions"]["uav"]["models"]}
+HZO_SUMMARY = ["results/horizon/optimiser_summary.csv"] if HZO_MODELS else []
+if HZO_MODELS:
+    REPORT_SECTIONS["horizon_optimiser"] = "results/report/horizon_optimiser.json"
+    REPORT_FIGURES.extend(OPTIMISER_FIGURES)
 
 
 wildcard_constraints:
@@ -48,7 +68,7 @@ rule horizon_uav:
         models=canonical(config["decisions"]["uav"]["models"]),
         cfg=pick(HZ, "runs", "steps", "plans", "n_ref", "replicates", "methods"),
         scoring=DEC_SCORING,
-        seed=config["seed"],
+        seed=HZ_SEED,
         code=code_digest("workflow/scripts/horizon_uav.py"),
     script:
         "../scripts/horizon_uav.py"
@@ -73,7 +93,7 @@ rule horizon_uav_closed:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         models=canonical(config["decisions"]["uav"]["models"]),
         cfg=pick(HZ, "closed_runs", "methods"),
-        seed=config["seed"],
+        seed=HZ_SEED,
         code=code_digest("workflow/scripts/horizon_uav_closed.py"),
     script:
         "../scripts/horizon_uav_closed.py"
@@ -97,7 +117,7 @@ rule horizon_lqg_estimators:
     params:
         cfg=pick(HZL, "sim_a", "sim_H", "replicates", "estimators"),
         model=HZL_MODEL,
-        seed=config["seed"],
+        seed=HZ_SEED,
         code=code_digest("workflow/scripts/horizon_lqg_estimators.py"),
     script:
         "../scripts/horizon_lqg_estimators.py"
@@ -121,7 +141,7 @@ rule horizon_lqg_regret:
     params:
         cfg=pick(HZL, "sim_a", "sim_H", "replicates", "regret"),
         model=HZL_MODEL,
-        seed=config["seed"],
+        seed=HZ_SEED,
         code=code_digest("workflow/scripts/horizon_lqg_regret.py"),
     script:
         "../scripts/horizon_lqg_regret.py"
@@ -135,6 +155,7 @@ rule horizon_summary:
         closed=expand("results/horizon/uav/{job}_closed.csv", job=HZ_JOBS),
         lqg_estimators="results/horizon/lqg_estimators.csv",
         lqg_regret="results/horizon/lqg_regret.csv",
+        optimiser=HZO_SUMMARY,
     output:
         approx="results/horizon/uav_approx_summary.csv",
         regret="results/horizon/uav_regret_summary.csv",
@@ -157,7 +178,9 @@ rule horizon_summary:
         cfg=canonical(HZ),
         lqg=canonical(HZL),
         lqg_model=pick(config["lqg"]["model"], "a", "x0", "r", "target", "sigma"),
-        seed=config["seed"],
+        # the optimiser budget every planner of the study runs at (HZ-3, section text)
+        planner=pick(config["uav"]["planner"], "maxiter", "maxfun", "restarts"),
+        seed=HZ_SEED,
         code=code_digest("workflow/scripts/horizon_summary.py"),
     script:
         "../scripts/horizon_summary.py"
@@ -210,15 +233,92 @@ rule horizon_recording:
         models=canonical(config["decisions"]["uav"]["models"]),
         cfg=pick(HZ, "closed_runs", "methods", "claims"),
         recording=canonical(HZ_REC),
-        seed=config["seed"],
+        seed=HZ_SEED,
         code=code_digest("workflow/scripts/horizon_recording.py"),
     script:
         "../scripts/horizon_recording.py"
 
 
+rule horizon_optimiser:
+    """Optimiser split, one model variant and horizon: every method's plan under each optimiser budget, the near-global minimiser of its own cost, the regret split into approximation and optimisation parts."""
+    output:
+        "results/horizon/optimiser/{hmodel}_H{H}.csv",
+    log:
+        "results/logs/horizon_optimiser/{hmodel}_H{H}.log",
+    benchmark:
+        "results/benchmarks/horizon_optimiser/{hmodel}_H{H}.tsv"
+    priority: PRIORITY["horizon_uav"]
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=120,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        model=lambda wc: HZ_VARIANTS[wc.hmodel],
+        cfg=pick(HZO, *HZO_KEYS),
+        scoring=pick(DEC["uav"], "n_eval", "polish", "random_starts"),
+        seed=HZ_SEED,
+        code=code_digest("workflow/scripts/horizon_optimiser.py"),
+    script:
+        "../scripts/horizon_optimiser.py"
+
+
+rule horizon_optimiser_summary:
+    """Optimiser split: mean total, approximation and optimisation regret per model, H, method and budget with cluster-t CIs, the optimiser's counters, table and report section."""
+    input:
+        expand("results/horizon/optimiser/{job}.csv", job=HZO_JOBS),
+    output:
+        summary="results/horizon/optimiser_summary.csv",
+        tables=table_outputs(OPTIMISER_TABLES, "Long horizons"),
+        section="results/report/horizon_optimiser.json",
+    log:
+        "results/logs/horizon_optimiser_summary.log",
+    benchmark:
+        "results/benchmarks/horizon_optimiser_summary.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=10,
+    params:
+        models=HZO_MODELS,
+        cfg=pick(HZO, "H", *HZO_KEYS),
+        planner=pick(config["uav"]["planner"], "maxiter", "maxfun", "restarts"),
+        code=code_digest("workflow/scripts/horizon_optimiser_summary.py"),
+    script:
+        "../scripts/horizon_optimiser_summary.py"
+
+
+rule horizon_optimiser_figures:
+    """Optimiser split figure: total regret at the default and the largest budget and the approximation part against H, per model and method."""
+    input:
+        "results/horizon/optimiser_summary.csv",
+    output:
+        figure_outputs(OPTIMISER_FIGURES, "Long horizons"),
+    log:
+        "results/logs/horizon_optimiser_figures.log",
+    benchmark:
+        "results/benchmarks/horizon_optimiser_figures.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
+    params:
+        code=code_digest("workflow/scripts/horizon_optimiser_figures.py"),
+    script:
+        "../scripts/horizon_optimiser_figures.py"
+
+
 rule horizon:
-    """Target: the long-horizon study (nothing when no model is configured)."""
+    """Target: the long-horizon study and its optimiser split (nothing when no model is configured)."""
     input:
         rules.horizon_summary.output if HZ_MODELS else [],
         rules.horizon_figures.output if HZ_MODELS else [],
         HZ_RECORDING,
+        rules.horizon_optimiser_summary.output if HZO_MODELS else [],
+        rules.horizon_optimiser_figures.output if HZO_MODELS else [],

@@ -28,6 +28,13 @@ rule report:
         runtime=5,
     params:
         config=canonical(config),
+        # the preregistration the confirmatory claims were judged under (claims.json,
+        # make verify): path, sha256 and the commit that added it
+        preregistration=(
+            {k: CONFIRM[k] for k in ("path", "sha256", "commit")}
+            if CONFIRM is not None
+            else {}
+        ),
         code=code_digest("workflow/scripts/report.py"),
     script:
         "../scripts/report.py"

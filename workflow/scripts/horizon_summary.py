@@ -18,8 +18,9 @@ from rsmhp.analysis.horizon_lqg import (
 from rsmhp.contracts import read_checked
 from rsmhp.experiments.horizon import closed_contract, horizon_contracts
 from rsmhp.experiments.horizon_lqg import estimator_contract, regret_contract
-from rsmhp.io import write_csv, write_text
+from rsmhp.io import read_table, write_csv, write_text
 from rsmhp.narrative.horizon import horizon_section, horizon_tables
+from rsmhp.narrative.optimiser_split import SUMMARY_COLUMNS as OPTIMISER_COLUMNS
 from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake) as log:
@@ -48,9 +49,11 @@ with rule_logging(snakemake) as log:
         lq["a_values"], lq["H"], r=model["r"], sigma=model["sigma"], eps=lq["eps"]
     )
     tables = horizon_tables(a_sum, r_sum, lqg_table, c_sum, est_sum, reg_sum)
+    opt = snakemake.input.optimiser
+    optimiser = read_table(opt[0], OPTIMISER_COLUMNS) if opt else None
     section = horizon_section(
         approx, a_sum, r_sum, tables, p.cfg, p.seed, lqg_table, lq, model["a"], closed,
-        c_sum, est, est_sum, reg_sum,
+        c_sum, est, est_sum, reg_sum, planner=p.planner, optimiser=optimiser,
     )  # fmt: skip
     write_csv(a_sum, snakemake.output.approx)
     write_csv(r_sum, snakemake.output.regret)

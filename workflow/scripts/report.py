@@ -31,6 +31,11 @@ with rule_logging(snakemake) as log:
     # the report summarises it; host and date stay in the JSON (they change every run), the
     # code as one digest per rule
     summary = {k: v for k, v in prov.items() if k not in ("host", "date (UTC)", "code")}
+    pre = snakemake.params.preregistration
+    if pre:
+        summary["preregistration"] = (
+            f"{pre['path']} sha256 {pre['sha256']} (commit {pre['commit']})"
+        )
     summary["code (rule digest)"] = ", ".join(
         f"{rule} {' / '.join(e['recorded'])}" for rule, e in prov["code"]["rules"].items()
     )
@@ -44,6 +49,7 @@ with rule_logging(snakemake) as log:
     claims_file = {
         "config sha256": prov.get("config sha256"),
         "commit": prov.get("commit"),
+        "preregistration": dict(snakemake.params.preregistration),
         "statements": statements_records(judge_all(claims)[0]),
         "claims": records,
     }

@@ -12,7 +12,11 @@ horizons of ``horizon.uav.H``.
   mean error of the Monte-Carlo member − NBO's at H_hi) − (the same at H_lo), paired over
   runs (the same scenarios at both H; m). The advantage of sampling over NBO grows with H:
   *supported* if the 95% Student-t CI of D over runs lies below 0, *not supported* above 0,
-  *inconclusive* otherwise.
+  *inconclusive* otherwise. Both planners of the closed loop run at the optimiser budget of
+  ``uav.planner`` (the same at every H), so D carries each planner's optimisation
+  error besides its cost-approximation error; the measured text says which budget
+  (:func:`budget_text`) and points to the section that splits the two
+  (:mod:`rsmhp.narrative.optimiser_split`).
 * **HZ-2** (:func:`hz2_rule`): d = g(pruned tree) − g(Monte Carlo with N_T = M), the
   members fixed in ``horizon.uav.claims``, from the smallest H at which the tree is pruned
   (N^(H+1) > M leaves, so it keeps M trajectories, as many as Monte Carlo) to H_hi. The
@@ -57,6 +61,7 @@ from rsmhp.analysis.horizon_lqg import pruned_growth
 from rsmhp.experiments.horizon_lqg import pruned_from
 from rsmhp.ledger import Claim, KeyNumber
 from rsmhp.markdown import fmt, fmt_ci
+from rsmhp.narrative.optimiser_split import TITLE as SPLIT_TITLE
 from rsmhp.palette import method_label
 from rsmhp.uav import methods as registry
 from rsmhp.verdicts import Case, Rule, ci_side, decisive_p
@@ -65,6 +70,7 @@ __all__ = [
     "HZ5_RULE",
     "KEY",
     "Evidence",
+    "budget_text",
     "horizon_claims",
     "horizon_evidence",
     "hz1_rule",
@@ -129,6 +135,29 @@ def _runs_needed_text(runs: float) -> str:
     return f"{int(runs)}" if math.isfinite(runs) else "more than 10⁶"
 
 
+def budget_text(planner: Mapping[str, Any] | None) -> str:
+    """The optimiser budget of ``uav.planner`` in words (``maxiter 30, maxfun 60, no
+    restarts``); '' without it."""
+    if not planner:
+        return ""
+    restarts = int(planner.get("restarts", 0) or 0)
+    return f"maxiter {int(planner['maxiter'])}, maxfun {int(planner['maxfun'])}, " + (
+        "no restarts" if restarts == 0 else f"{restarts} restart{'s' * (restarts > 1)}"
+    )
+
+
+def _hz3_budget_text(planner: Mapping[str, Any] | None) -> str:
+    """HZ-3's measured text on the optimiser budget of its closed-loop runs."""
+    budget = budget_text(planner)
+    return (
+        "; both planners ran at the optimiser budget of uav.planner"
+        + (f" ({budget})" if budget else "")
+        + " at every H, so D carries each planner's optimisation error besides its "
+        "cost-approximation error (the open-loop split of the two: section "
+        f"'{SPLIT_TITLE}')"
+    )
+
+
 def hz1_rule(h_lo: int, h_hi: int) -> Rule:
     """HZ-1: NBO's relative RMSE is larger at H_hi than at H_lo."""
     return ci_side(
@@ -163,12 +192,12 @@ def hz3_rule(mc: str, h_lo: int, h_hi: int) -> Rule:
 
 
 def _hz3(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: int,
-         n_boot: int) -> Claim:  # fmt: skip
-    return _hz3_evidence(closed, model, mc, h_lo, h_hi, seed, n_boot).claim
+         n_boot: int, planner: Mapping[str, Any] | None = None) -> Claim:  # fmt: skip
+    return _hz3_evidence(closed, model, mc, h_lo, h_hi, seed, n_boot, planner).claim
 
 
 def _hz3_evidence(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: int,
-                  n_boot: int) -> Evidence:  # fmt: skip
+                  n_boot: int, planner: Mapping[str, Any] | None = None) -> Evidence:  # fmt: skip
     a: Advantage = advantage_growth(closed, model, mc, h_lo, h_hi, seed, n_boot)
     rule = hz3_rule(mc, h_lo, h_hi)
     half = (a.high - a.low) / 2
@@ -200,7 +229,8 @@ def _hz3_evidence(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: in
         + _test_text(p, a.df, a.boot_low, a.boot_high, 3, "m", boot_verdict)
         + f"; a confirmatory run would need {_runs_needed_text(a.runs_needed)} paired runs to "
         "detect a D of the observed size with 80% power (paired t-test at 5%; the observed D is "
-        "taken as the true effect, which is optimistic if selection inflated it)",
+        "taken as the true effect, which is optimistic if selection inflated it)"
+        + _hz3_budget_text(planner),
         part="beyond",
         setup=f"UAV '{model}', closed loop, H = {h_lo} and {h_hi}",
     )
@@ -235,12 +265,14 @@ def horizon_claims(
     cfg: Mapping[str, Any],
     seed: int,
     closed: pd.DataFrame | None = None,
+    planner: Mapping[str, Any] | None = None,
 ) -> list[Claim]:
     """HZ-1 and HZ-2 per model of ``summary``, HZ-3 on the configured model (module doc).
     ``approx``: the cost-approximation rows of every (model, H); ``summary``:
     :func:`rsmhp.analysis.horizon.summarize_approx`; ``cfg``: ``horizon.uav``; ``closed``:
-    the closed-loop rows (:data:`rsmhp.experiments.horizon.CLOSED_COLUMNS`)."""
-    return [e.claim for e in horizon_evidence(approx, summary, cfg, seed, closed)]
+    the closed-loop rows (:data:`rsmhp.experiments.horizon.CLOSED_COLUMNS`); ``planner``:
+    ``uav.planner`` (its maxiter, maxfun and restarts: HZ-3's measured text)."""
+    return [e.claim for e in horizon_evidence(approx, summary, cfg, seed, closed, planner)]
 
 
 def horizon_evidence(
@@ -249,6 +281,7 @@ def horizon_evidence(
     cfg: Mapping[str, Any],
     seed: int,
     closed: pd.DataFrame | None = None,
+    planner: Mapping[str, Any] | None = None,
 ) -> list[Evidence]:
     """The claims of :func:`horizon_claims` (same arguments), each with its primary test's
     p-value and the percentile-bootstrap CI it replaced (:class:`Evidence`)."""
@@ -327,7 +360,7 @@ def horizon_evidence(
                 setup=f"UAV '{model}', belief states of NBO runs, H = {tree_lo} to {h_hi}",
             )
             out.append(Evidence(claim, p_value, d.df, p.boot_low, p.boot_high, boot_verdict))
-    out += _hz3_claims(closed, cfg, mc, seed, n_boot)
+    out += _hz3_claims(closed, cfg, mc, seed, n_boot, planner)
     return out
 
 
@@ -340,7 +373,12 @@ def _pruned_from(tree: str, hs: list[int]) -> int | None:
 
 
 def _hz3_claims(
-    closed: pd.DataFrame | None, cfg: Mapping[str, Any], mc: str | None, seed: int, n_boot: int
+    closed: pd.DataFrame | None,
+    cfg: Mapping[str, Any],
+    mc: str | None,
+    seed: int,
+    n_boot: int,
+    planner: Mapping[str, Any] | None = None,
 ) -> list[Evidence]:
     """HZ-3 on ``horizon.uav.claims.closed_model``, between the smallest and largest H of the
     closed-loop rows (none if either is missing)."""
@@ -351,7 +389,7 @@ def _hz3_claims(
     hs = sorted(int(h) for h in sel["H"].unique())
     if len(hs) < 2 or mc not in set(sel["method"]):
         return []
-    return [_hz3_evidence(closed, model, mc, hs[0], hs[-1], seed, n_boot)]
+    return [_hz3_evidence(closed, model, mc, hs[0], hs[-1], seed, n_boot, planner)]
 
 
 def hz4_rule(N: int, M: int, h_lo: int, h_hi: int) -> Rule:

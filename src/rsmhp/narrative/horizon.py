@@ -11,10 +11,12 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from rsmhp.claims.horizon import Evidence, horizon_evidence, lqg_horizon_claims
+from rsmhp.claims.horizon import Evidence, budget_text, horizon_evidence, lqg_horizon_claims
 from rsmhp.figures.horizon import FIGURES
 from rsmhp.ledger import Claim, Section
 from rsmhp.markdown import ci_cells, fmt, markdown_table, range_text
+from rsmhp.narrative.optimiser_split import TITLE as SPLIT_TITLE
+from rsmhp.narrative.optimiser_split import horizon_note
 from rsmhp.palette import method_label
 
 __all__ = ["FIGURES", "TABLES", "horizon_section", "horizon_tables"]
@@ -367,6 +369,20 @@ def _findings(claims: Sequence[Claim], a: pd.DataFrame, r: pd.DataFrame) -> str:
     return " ".join(out)
 
 
+def _budget_text(planner: Mapping[str, Any] | None, optimiser: pd.DataFrame | None) -> str:
+    """Which regret the study shows: every planner at uav.planner's optimiser budget, and
+    the pointer to the optimiser split (with its numbers at the largest H if given)."""
+    budget = budget_text(planner)
+    return (
+        "Optimiser budget: every planner that optimises a plan (all but the tree search), in "
+        "the open-loop regret and time and in the closed loop (HZ-3), runs at uav.planner's "
+        "budget"
+        + (f" ({budget})" if budget else "")
+        + ", the same for every method and H, so its regret mixes cost-approximation and "
+        "optimisation error. " + horizon_note(optimiser)
+    )
+
+
 _LQG_FIGURE = [
     "![Oven LQG at long horizons](figures/hz_lqg.png)",
     "",
@@ -409,11 +425,16 @@ def horizon_section(
     lqg_est: pd.DataFrame | None = None,
     lqg_est_summary: pd.DataFrame | None = None,
     lqg_regret_summary: pd.DataFrame | None = None,
+    planner: Mapping[str, Any] | None = None,
+    optimiser: pd.DataFrame | None = None,
 ) -> Section:
     """The horizon study's report section (order 33); ``cfg`` is ``horizon.uav``,
     ``lqg_cfg`` ``horizon.lqg``, ``a_model`` the oven model's a (``lqg.model.a``); the LQG
-    simulation rows and summaries of :mod:`rsmhp.analysis.horizon_lqg` (omitted: no HZ-4/5)."""
-    evidence = horizon_evidence(approx, approx_summary, cfg, seed, closed)
+    simulation rows and summaries of :mod:`rsmhp.analysis.horizon_lqg` (omitted: no HZ-4/5);
+    ``planner``: ``uav.planner`` (the optimiser budget every planner runs at); ``optimiser``:
+    the optimiser split's summary (:func:`rsmhp.narrative.optimiser_split.optimiser_summary`;
+    omitted: the text points to its section without its numbers)."""
+    evidence = horizon_evidence(approx, approx_summary, cfg, seed, closed, planner)
     claims = [e.claim for e in evidence]
     empty = pd.DataFrame()
     est = lqg_est if lqg_est is not None else empty
@@ -426,6 +447,8 @@ def horizon_section(
             _setting(cfg, hs),
             "",
             _findings(claims, approx_summary, regret_summary),
+            "",
+            _budget_text(planner, optimiser),
             "",
             _interval_text(evidence),
             "",
@@ -458,8 +481,8 @@ def horizon_section(
             "Open-loop regret (percent of the best plan found) and planning time per model, "
             "horizon and method ('vs best of methods' plans': regret against the best of the "
             "plans the methods found themselves, at their common optimiser budget; it mixes "
-            "each method's cost-approximation error with its optimisation error, and the "
-            "split between the two is not measured yet):",
+            "each method's cost-approximation error with its optimisation error, split in "
+            f"section '{SPLIT_TITLE}'):",
             "",
             tables["hz_uav_regret"],
             "",

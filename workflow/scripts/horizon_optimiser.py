@@ -1,0 +1,10 @@
+"""Rule horizon_optimiser: the optimiser split of one model variant and horizon."""
+
+from rsmhp.experiments.optimiser_split import run_optimiser_split
+from rsmhp.io import write_csv
+from rsmhp.pipeline import rule_logging
+
+with rule_logging(snakemake):
+    p, w = snakemake.params, snakemake.wildcards
+    table = run_optimiser_split(p.uav, p.model, int(w.H), p.cfg, p.scoring, p.seed)
+    write_csv(table, snakemake.output[0])
