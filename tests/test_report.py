@@ -277,7 +277,7 @@ def test_verify_cli(tmp_path, capsys):
 
 
 def test_published_report_matches_its_claims_and_the_readme():
-    """paper/ is what `make publish` copied from one run: the main text is <= 52 KB, has no
+    """paper/ is what `make publish` copied from one run: the main text is <= 55 KB, has no
     nan/inf, lists exactly the claims of paper/claims.json with their verdicts, and the
     README's results block is the glance table of the same claims (generated, not copied)."""
     main = (ROOT / "paper/replication.md").read_text(encoding="utf-8")
@@ -285,7 +285,9 @@ def test_published_report_matches_its_claims_and_the_readme():
     data = json.loads((ROOT / "paper/claims.json").read_text(encoding="utf-8"))
     claims = [Claim.from_dict(c) for c in data["claims"]]
     # the two-part ledger with every rule and the contrary evidence next to its claim
-    assert len(main.encode()) <= 52_000  # seven study sections and a two-part ledger (34 claims)
+    # eight study sections (the confirmatory protocol and the optimiser split added 4.8 KB,
+    # 4.3 KB moved to the appendix in exchange) and a two-part ledger (34 claims)
+    assert len(main.encode()) <= 55_000
     for text in (main, appendix):
         assert not re.search(r"\b(nan|inf)\b", text, flags=re.IGNORECASE)
     for c in claims:

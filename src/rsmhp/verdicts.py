@@ -247,11 +247,10 @@ def holm_correct(
         key = dataclasses.replace(c.key, p_holm=float(p))
         verdict, rule = c.verdict, c.rule
         note = (
-            f" Holm's correction over the {len(idx)} claims {', '.join(family)}*: adjusted "
-            f"p = {p:.3g}"
+            f" Holm over {len(idx)} {'/'.join(f.rstrip('-') for f in family)} claims: p = {p:.3g}"
         )
         if verdict in ("supported", "not supported", "equivalent") and p >= alpha:
-            note += f" ≥ {alpha:g}, so {verdict} at the 95% level alone becomes inconclusive"
+            note += f" ≥ {alpha:g}: {verdict} without it, becomes inconclusive"
             verdict = "inconclusive"
         out[i] = dataclasses.replace(c, key=key, verdict=verdict, rule=rule + "." + note)
     return out

@@ -21,7 +21,7 @@ from __future__ import annotations
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
-from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, NullFormatter
 
 from rsmhp.figures import theme
 from rsmhp.palette import method_colour
@@ -145,7 +145,12 @@ def confirm_figure(lad: pd.DataFrame) -> plt.Figure:
                     label=fams[fam].family_label if fam in fams else fam,
                 )
             ax.set_xscale("log")
-            ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+            if xcol == "budget_ms":  # the preregistered budgets themselves
+                ax.xaxis.set_major_locator(FixedLocator(sorted(set(g["budget_ms"]))))
+            elif xcol == "work_per_step":  # decades only: the counts span 3 to 4 of them
+                ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0,)))
+            else:
+                ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
             ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
             ax.xaxis.set_minor_formatter(NullFormatter())
             ax.set_xlabel(xlabel)

@@ -119,7 +119,6 @@ def optimiser_figure(summary: pd.DataFrame) -> plt.Figure:
         ax.set_yscale("symlog", linthresh=LINTHRESH_PCT)
         ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
         ax.yaxis.set_minor_formatter(NullFormatter())
-        ax.set_ylim(bottom=0.0)
         ax.set_xscale("log")
         ax.xaxis.set_major_locator(FixedLocator(hs))
         ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
@@ -134,6 +133,9 @@ def optimiser_figure(summary: pd.DataFrame) -> plt.Figure:
         Line2D([], [], color="0.3", ls=ls, marker=marker, ms=4, label=label)
         for _, _, ls, marker, label in series
     ]
+    # the shared y axis starts at 0 once every panel is drawn (set inside the loop it would
+    # freeze the top at the first panel's data and cut the others' lines)
+    axes[0, 0].set_ylim(bottom=0.0)
     axes[0, -1].legend(handles=handles, fontsize="x-small", loc="best")
     fig.suptitle("Optimiser error apart from approximation error, by horizon", fontsize=11)
     fig.tight_layout()

@@ -452,11 +452,7 @@ def horizon_section(
             "",
             _interval_text(evidence),
             "",
-            _runs_text(closed_summary) if closed_summary is not None else "",
-            "",
             _lqg_text(lqg_table, a_model, float(lqg_cfg["eps"])),
-            "",
-            _lqg_sim_text(est_s, reg_s, a_model),
             "",
             *_FIGURE,
             "",
@@ -466,6 +462,11 @@ def horizon_section(
     claims = [*claims, *lqg_claims]
     appendix = "\n".join(
         [
+            # moved from the main text (its size budget): runs needed, the simulated oven LQG
+            _runs_text(closed_summary) if closed_summary is not None else "",
+            "",
+            _lqg_sim_text(est_s, reg_s, a_model),
+            "",
             "Cost approximation per model, horizon and method (relative bias and RMSE of the "
             "cost estimate in percent of the reference cost, 95% cluster-t CIs over runs: "
             "jackknife leaving out one run with its belief states, t with runs − 1 df; the "

@@ -331,11 +331,13 @@ def optimiser_section(
     order = budget_order(summary)
     first, big = order[0], largest_budget(order)
     per_budget = markdown_table(budget_table(summary), digits=3, signed=("O %", "largest O %"))
+    # the main text: the split and what removes it; definitions, setting and the per-budget
+    # table in the appendix (main-text budget of the report)
     body = "\n".join(
         [
-            _definitions(cfg),
-            "",
-            _setting(summary, cfg, planner),
+            "R = total open-loop regret of a plan, A = the regret of the near-global "
+            "minimiser of the method's own cost (approximation), O = R − A (optimisation); "
+            "definitions and setting in the appendix.",
             "",
             _split_text(summary, first, big),
             "",
@@ -343,16 +345,20 @@ def optimiser_section(
             "",
             _removal_text(summary),
             "",
-            "Per budget, over every (model, H, method) cell (iterations, converged and 0 "
-            "iterations: over all plans; R and O: mean of the cells' means):",
-            "",
-            per_budget,
-            "",
             *_FIGURE,
         ]
     )
     appendix = "\n".join(
         [
+            _definitions(cfg),
+            "",
+            _setting(summary, cfg, planner),
+            "",
+            "Per budget, over every (model, H, method) cell (iterations, converged and 0 "
+            "iterations: over all plans; R and O: mean of the cells' means):",
+            "",
+            per_budget,
+            "",
             "Optimiser split per model, horizon, method and budget: R, A, O = total, "
             "approximation and optimisation regret (percent of the best plan found, mean over "
             "belief states, 95% cluster-t CIs over runs: jackknife leaving out one run with its "
