@@ -172,6 +172,15 @@ def test_bad_uav_values_are_named(path, value, expected):
         ("decisions.recording.select", "first", r"decisions\.recording\.select: 'first'"),
         ("decisions.frontier.budget.ms_per_step", 0, r"frontier\.budget\.ms_per_step: 0 "),
         ("decisions.frontier.claims.margin_pp", -0.1, r"frontier\.claims\.margin_pp: -0\.1 "),
+        ("decisions.frontier.timing.steps", [0, 70], r"frontier\.timing\.steps: \[70\]"),
+        (
+            "decisions.frontier.tuning.timing.steps",
+            [99],
+            r"frontier\.tuning\.timing\.steps: \[99\]",
+        ),
+        ("decisions.frontier.tuning.budgets_ms", [0], r"tuning\.budgets_ms\[0\]: 0 "),
+        ("decisions.frontier.tuning.runs", 1, r"tuning\.runs: 1 "),
+        ("horizon.stream", "judge", r"horizon\.stream: 'judge'"),
     ],
 )
 def test_bad_decision_values_are_named(path, value, expected):
@@ -336,3 +345,10 @@ def test_merge_follows_snakemakes_overlay_rule():
     base = {"a": {"b": 1, "c": [1, 2]}, "d": 1}
     assert merge(base, {"a": {"c": [3]}}) == {"a": {"b": 1, "c": [3]}, "d": 1}
     assert base == {"a": {"b": 1, "c": [1, 2]}, "d": 1}
+
+
+def test_the_exploratory_frontier_needs_two_regret_runs():
+    cfg = _with("decisions.frontier.exploratory", True)
+    cfg["decisions"]["frontier"]["regret_runs"] = 1
+    with pytest.raises(ConfigError, match=r"frontier\.regret_runs: 1 \(allowed: at least 2"):
+        check_config(cfg)

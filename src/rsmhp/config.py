@@ -292,6 +292,12 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
                 f"{path}: {late} not before the run's last step (allowed: 0 <= step < "
                 f"uav.scenario.steps = {n_steps})"
             )
+    rr = fr.get("regret_runs", 10)
+    if fr.get("exploratory") and isinstance(rr, int) and rr < 2:
+        problems.append(
+            f"decisions.frontier.regret_runs: {rr} (allowed: at least 2 with "
+            "decisions.frontier.exploratory: true: its open-loop CIs are over runs)"
+        )
     names = [m.get("name") for m in (dec.get("uav", {}) or {}).get("models", []) or []]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
