@@ -272,15 +272,18 @@ def emulation_env(
 
 def copy_workflow(root: str | os.PathLike, dest: str | os.PathLike) -> Path:
     """Copy the workflow of checkout ``root`` (Snakefile, ``workflow/``, ``config/``,
-    ``src/``; caches and build files aside) to ``dest`` (replaced); the copy's Snakefile."""
+    ``src/``, and the data files the workflow reads at parse time: ``paper/exploratory/``
+    and ``tests/config/``, where the test config's tuned file and preregistration live;
+    caches and build files aside) to ``dest`` (replaced); the copy's Snakefile."""
     root, dest = Path(root), Path(dest)
     if dest.exists():
         shutil.rmtree(dest)
     dest.mkdir(parents=True)
     shutil.copy2(root / "Snakefile", dest / "Snakefile")
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info", "*.nbi", "*.nbc")
-    for sub in ("workflow", "config", "src"):
-        shutil.copytree(root / sub, dest / sub, ignore=ignore)
+    for sub in ("workflow", "config", "src", "paper/exploratory", "tests/config"):
+        if (root / sub).is_dir():
+            shutil.copytree(root / sub, dest / sub, ignore=ignore)
     return dest / "Snakefile"
 
 

@@ -417,7 +417,9 @@ def file_commit(path: str | Path) -> str:
 
 def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, Any] | None:
     """What the workflow's confirmatory rules need (JSON-ready, the rules' params): the
-    preregistration (content, path, sha256, commit), the tuned file (content, sha256), and
+    preregistration (content, path, sha256; the commit that added it is looked up by the
+    rule when it runs, :func:`file_commit`, so that a copy of the workflow outside git does
+    not rerun anything), the tuned file (content, sha256), and
     per model its runs and configurations; ``None`` when ``decisions.frontier`` has no model
     or the preregistration file does not exist (the report then has no FR claims). A
     preregistration that does not fit the tuned file, or names a model outside
@@ -442,7 +444,6 @@ def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, 
         "preregistration": dict(pre.doc),
         "path": str(conf["preregistration"]),
         "sha256": pre.sha256,
-        "commit": file_commit(pre_path),
         "tuned": tuned,
         "tuned_sha256": file_sha256(tuned_path),
         "models": models,

@@ -29,11 +29,9 @@ rule report:
     params:
         config=canonical(config),
         # the preregistration the confirmatory claims were judged under (claims.json,
-        # make verify): path, sha256 and the commit that added it
+        # make verify): path and sha256 (the script adds the commit that added it)
         preregistration=(
-            {k: CONFIRM[k] for k in ("path", "sha256", "commit")}
-            if CONFIRM is not None
-            else {}
+            {k: CONFIRM[k] for k in ("path", "sha256")} if CONFIRM is not None else {}
         ),
         code=code_digest("workflow/scripts/report.py"),
     script:

@@ -12,7 +12,7 @@ from rsmhp.experiments.frontier import config_runs_contract, config_timing_contr
 from rsmhp.io import write_csv, write_text
 from rsmhp.narrative.frontier import confirm_section, confirm_tables
 from rsmhp.pipeline import rule_logging
-from rsmhp.protocol import Configuration, tuned_configurations
+from rsmhp.protocol import Configuration, file_commit, tuned_configurations
 
 with rule_logging(snakemake) as log:
     c = snakemake.params.confirm
@@ -42,7 +42,8 @@ with rule_logging(snakemake) as log:
     claims = confirm_claims(runs, summary, lad, pre, chosen, c["sha256"])
     tables = confirm_tables(summary, lad, c["tuned"])
     exploratory = snakemake.params.exploratory
-    meta = {"path": c["path"], "sha256": c["sha256"], "commit": c["commit"]}
+    commit = file_commit(Path(snakemake.scriptdir).parents[1] / c["path"])
+    meta = {"path": c["path"], "sha256": c["sha256"], "commit": commit}
     section = confirm_section(summary, lad, claims, tables, pre, meta, c["tuned"], exploratory)
     write_csv(summary, snakemake.output.summary)
     write_csv(lad, snakemake.output.ladder)

@@ -10,6 +10,7 @@ from rsmhp.claims.paper import judge_all
 from rsmhp.io import write_text
 from rsmhp.ledger import Section, claims_records
 from rsmhp.pipeline import rule_logging
+from rsmhp.protocol import file_commit
 from rsmhp.provenance import code_provenance, provenance
 from rsmhp.report import glance_table, render_appendix, render_report, statements_records
 from rsmhp.verdicts import holm_sections
@@ -31,8 +32,9 @@ with rule_logging(snakemake) as log:
     # the report summarises it; host and date stay in the JSON (they change every run), the
     # code as one digest per rule
     summary = {k: v for k, v in prov.items() if k not in ("host", "date (UTC)", "code")}
-    pre = snakemake.params.preregistration
+    pre = dict(snakemake.params.preregistration)
     if pre:
+        pre["commit"] = file_commit(Path(snakemake.scriptdir).parents[1] / pre["path"])
         summary["preregistration"] = (
             f"{pre['path']} sha256 {pre['sha256']} (commit {pre['commit']})"
         )
@@ -49,7 +51,7 @@ with rule_logging(snakemake) as log:
     claims_file = {
         "config sha256": prov.get("config sha256"),
         "commit": prov.get("commit"),
-        "preregistration": dict(snakemake.params.preregistration),
+        "preregistration": pre,
         "statements": statements_records(judge_all(claims)[0]),
         "claims": records,
     }
