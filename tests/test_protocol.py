@@ -35,10 +35,12 @@ CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 MODELS = [{"name": "paper"}, {"name": "footprint150", "sensor": {"footprint_radius": 150.0}}]
 
 
-def test_streams_are_the_seed_and_two_derived_roots():
+def test_streams_are_the_seed_and_derived_roots():
     assert stream_seed(7, "exploratory") == 7
     tune, confirm = stream_seed(7, "tune"), stream_seed(7, "confirm")
-    assert len({7, tune, confirm}) == 3 and 0 <= tune < 2**63 and 0 <= confirm < 2**63
+    confirm2 = stream_seed(7, "confirm2")
+    assert len({7, tune, confirm, confirm2}) == 4
+    assert all(0 <= s < 2**63 for s in (tune, confirm, confirm2))
     assert stream_seed(7, "confirm") == confirm and stream_seed(8, "confirm") != confirm
     with pytest.raises(ValueError, match="stream: 'judge'"):
         stream_seed(7, "judge")
@@ -88,8 +90,11 @@ def _tuning_tables(rng):
     ]
     ms = {c.name: v for c, v in zip(configs, [0.2, 0.6, 1.5, 0.3, 0.4, 2.5], strict=True)}
     err = {c.name: v for c, v in zip(configs, [12.0, 11.0, 10.5, 11.5, 13.0, 9.0], strict=True)}
+    # the closed loop's own planning time: below the timing's median except for the sigma
+    # points on model 'b', which spend 5x more in closed loop than at the timed states
     q, t = [], []
     for model, c, r in itertools.product(("a", "b"), configs, range(4)):
+        slow = 5.0 if (model == "b" and c.member == "sigma") else 0.9
         q.append(
             {
                 "model": model,
@@ -97,6 +102,7 @@ def _tuning_tables(rng):
                 "run": r,
                 "work_per_step": 10.0 * r,
                 "mean_error": err[c.name] + (0.5 if model == "b" else 0) + 0.01 * (r - 1.5),
+                "plan_ms": slow * ms[c.name] * (1 + 0.02 * (r - 1.5)),
             }
         )
         t.append({"model": model, "config": c.name, "ms": ms[c.name] * (1 + 0.01 * r)})  # fmt: skip
@@ -108,13 +114,16 @@ def test_selection_is_the_best_error_within_each_budget():
     budgets = [0.25, 1.0, 4.0]
     sel = protocol.select(q, t, configs, budgets)
     assert list(sel.columns) == protocol.SELECTION_COLUMNS
-    # brute force over the same tables
+    # brute force over the same tables: the cost is the larger of the timing's median and
+    # the closed loop's mean planning time
     med = t.groupby(["model", "config"])["ms"].median()
+    loop = q.groupby(["model", "config"])["plan_ms"].mean()
+    cost = np.maximum(med, loop.reindex(med.index))
     mean = q.groupby(["model", "config"])["mean_error"].mean()
     for model in ("a", "b"):
         for fam in ("rsmhp", "sigma", "dpw"):
             for b in budgets:
-                fit = [c.name for c in configs if c.family == fam and med[(model, c.name)] <= b]
+                fit = [c.name for c in configs if c.family == fam and cost[(model, c.name)] <= b]
                 row = sel[(sel.model == model) & (sel.family == fam) & (sel.budget_ms == b)]
                 if not fit:
                     assert row.empty
@@ -124,8 +133,18 @@ def test_selection_is_the_best_error_within_each_budget():
     r = sel[(sel.model == "a") & (sel.family == "rsmhp")].set_index("budget_ms")["config"]
     assert r.to_dict() == {0.25: "rsmhp_nt16/it30/r0", 1.0: "rsmhp_nt64/it30/r0",
                            4.0: "rsmhp_nt64/it30/r2"}  # fmt: skip
+    # the sigma points fit 1 ms on 'a' (0.3 ms both ways) but not on 'b', whose closed loop
+    # spends 1.5 ms per step although the timing's median is 0.3 ms
+    sig = sel[(sel.family == "sigma") & (sel.budget_ms == 1.0)].set_index("model")
+    assert sig.loc["a", "config"] == "sigma/it30/r0"
+    assert "b" not in sig.index
+    assert sel[(sel.model == "b") & (sel.family == "sigma")]["budget_ms"].tolist() == [4.0]
+    row = sel[(sel.model == "b") & (sel.family == "sigma")].iloc[0]
+    assert row.plan_ms == pytest.approx(row.closed_loop_ms) and row.closed_loop_ms > row.timing_ms
     with pytest.raises(ValueError, match="no timing rows of 'dpw_s50'"):
         protocol.select(q, t[t.config != "dpw_s50"], configs, budgets)
+    with pytest.raises(ValueError, match=r"lack columns \['plan_ms'\]"):
+        protocol.select(q.drop(columns="plan_ms"), t, configs, budgets)
 
 
 def test_tuned_document_round_trips_into_configurations():
@@ -172,6 +191,8 @@ def test_preregistration_checks_the_tuned_file_and_lists_the_configurations(tmp_
         Preregistration.load(p, tuned)
     with pytest.raises(ValueError, match="stream 'tune'"):
         Preregistration.load(_prereg(tmp_path, "x", stream="tune"))
+    two = Preregistration.load(_prereg(tmp_path, "x", stream="confirm2"))
+    assert two.doc["stream"] == "confirm2"
     with pytest.raises(ValueError, match=r"headline_budget_ms 2\.0"):
         Preregistration.load(_prereg(tmp_path, "x", headline_budget_ms=2.0))
     with pytest.raises(ValueError, match="missing claims"):
@@ -263,7 +284,10 @@ def _confirm_tables(shift_rqmc=-0.5, shift_dpw=3.0, n=30, noise=0.3):
             runs.append({"model": "m", "config": name, "member": member or "nbo", "family": fam,
                          "maxiter": 30, "restarts": 1 if name.endswith("r1") else 0, "run": r,
                          "mean_error": common[r] + shift + own[r], "final_error": 1.0,
-                         "detect_rate": 1.0, "lost": False, "plan_ms": ms, "mean_nit": 5.0,
+                         "detect_rate": 1.0, "lost": False, "mean_nit": 5.0,
+                         # the closed loop's own time: the sigma points spend 4x the timed
+                         # 0.2 ms there (over the 0.5 ms budget), the others what is timed
+                         "plan_ms": 0.8 + 0.01 * (r % 3 - 1) if fam == "sigma" else ms,
                          "work_per_step": 100.0 * ms, "converged_rate": 1.0,
                          "plan_depth": 2.0 if fam == "dpw" else np.nan,
                          "max_depth": 3.0 if fam == "dpw" else np.nan,
@@ -320,6 +344,11 @@ def test_confirm_summary_ladder_and_claims_follow_the_data():
     lad = ladder(runs, summarize_configs(runs, timing), chosen, [0.5, 2.0])
     r = lad.set_index(["budget_ms", "family"])
     assert r.loc[(0.5, "rsmhp"), "within_budget"] and r.loc[(2.0, "rsmhp"), "within_budget"]
+    # the sigma points: timed within 0.5 ms, but their closed loop spends 0.8 ms per step
+    # (the mean over runs): over the budget on the tuning rule's cost, within 2 ms
+    assert r.loc[(0.5, "sigma"), "loop_ms"] == pytest.approx(0.8, abs=1e-3)
+    assert r.loc[(0.5, "sigma"), "plan_ms"] < 0.5
+    assert not r.loc[(0.5, "sigma"), "within_budget"] and r.loc[(2.0, "sigma"), "within_budget"]
     assert r.loc[(2.0, "rsmhp"), "diff_mc"] == 0.0
     p = paired_configs(runs, "m", "rqmc_nt16/it30/r0", "rsmhp_nt64/it30/r1")
     assert r.loc[(2.0, "rqmc"), "diff_mc"] == pytest.approx(p.mean)
@@ -362,10 +391,59 @@ def test_confirm_section_reads_its_numbers_from_the_tables():
                           {"path": "p.yaml", "sha256": "f" * 64, "commit": "c" * 40}, tuned,
                           [{"id": "FR-1-x", "key": {"value": 1.0, "ci_low": 0.5,
                                                     "ci_high": 1.5, "unit": "m"},
-                            "verdict": "supported"}])  # fmt: skip
+                            "verdict": "supported"}],
+                          superseded={"what": "budgeted on medians.",
+                                      "preregistration": {"sha256": "e" * 64,
+                                                          "commit": "d" * 40},
+                                      "claims": [{"id": "FR-2-y",
+                                                  "key": {"value": 2.0, "unit": "m"},
+                                                  "verdict": "inconclusive"}]})  # fmt: skip
     assert sec.key == "decisions_frontier" and len(sec.claims) == 3
+    assert "sha256 eeeeeeeeeeee, commit dddddddddd; superseded, not counted" in sec.appendix
+    assert "FR-2-y" in sec.appendix and "budgeted on medians." in sec.appendix
+    # what the members at the claims' budget spent in closed loop (2 ms: all within it)
+    assert "Closed-loop planning ms per step of the members at 2 ms" in sec.body
+    assert "(all within it)" in sec.body
     assert "7 candidate configurations" in sec.body and "sha256 ffffffffffff" in sec.body
     for c in claims:
         assert f"{c.id}" in sec.body
     assert "FR-1-x" in sec.appendix and "76a0c01" in sec.appendix
     assert "(no tuned configurations)" in tables["dec_confirm_tuning"]
+
+
+def _git(cwd, *args):
+    import subprocess
+
+    subprocess.run(["git", *args], cwd=cwd, check=True, capture_output=True)
+
+
+def test_file_commit_names_the_commit_and_refuses_a_wrong_path(tmp_path):
+    import shutil
+    import subprocess
+
+    if shutil.which("git") is None:
+        pytest.skip("git is not installed")
+    repo = tmp_path / "repo"
+    (repo / "config").mkdir(parents=True)
+    (repo / "workflow" / "scripts").mkdir(parents=True)
+    (repo / "workflow" / "rules").mkdir()
+    f = repo / "config" / "pre.yaml"
+    f.write_text("a: 1\n")
+    _git(repo, "init", "-q")
+    _git(repo, "-c", "user.name=t", "-c", "user.email=t@t", "add", ".")
+    _git(repo, "-c", "user.name=t", "-c", "user.email=t@t", "commit", "-qm", "pre")
+    head = subprocess.run(["git", "rev-parse", "HEAD"], cwd=repo, capture_output=True,
+                          text=True, check=True).stdout.strip()  # fmt: skip
+    assert protocol.file_commit(f) == head
+    # the scripts build the path from a script directory that holds '..' (Snakemake's
+    # scriptdir of "../scripts/x.py" is "<repo>/workflow/rules/../scripts"): resolved first
+    scriptdir = repo / "workflow" / "rules" / ".." / "scripts"
+    assert protocol.file_commit(Path(scriptdir).resolve().parents[1] / "config/pre.yaml") == head
+    # the unresolved parents[1] of such a path is the wrong directory: refused, not "unknown"
+    with pytest.raises(FileNotFoundError, match="does not exist"):
+        protocol.file_commit(Path(scriptdir).parents[1] / "config/pre.yaml")
+    f.write_text("a: 2\n")
+    assert protocol.file_commit(f) == "uncommitted"
+    outside = tmp_path / "outside.yaml"
+    outside.write_text("a: 1\n")
+    assert protocol.file_commit(outside) == "unknown"

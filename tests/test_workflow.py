@@ -694,7 +694,7 @@ def test_code_edits_rerun_exactly_the_rules_that_import_the_code(run_j2, tmp_pat
     wf, run = tmp_path / "wf", tmp_path / "run"
     wf.mkdir()
     shutil.copy2(ROOT / "Snakefile", wf / "Snakefile")
-    for d in ("workflow", "config", "src", "paper/exploratory", "tests/config"):
+    for d in ("workflow", "config", "src", "paper/exploratory", "paper/superseded", "tests/config"):
         shutil.copytree(ROOT / d, wf / d, ignore=shutil.ignore_patterns("*.pyc", "*.egg-info"))
     shutil.copytree(run_j2, run, symlinks=True)
     assert _dry_run(wf, run) == (set(), set())  # the copy is the same code: nothing to do

@@ -272,7 +272,8 @@ def emulation_env(
 
 def copy_workflow(root: str | os.PathLike, dest: str | os.PathLike) -> Path:
     """Copy the workflow of checkout ``root`` (Snakefile, ``workflow/``, ``config/``,
-    ``src/``, and the data files the workflow reads at parse time: ``paper/exploratory/``
+    ``src/``, and the data files the workflow reads at parse time: ``paper/exploratory/``,
+    ``paper/superseded/``
     and ``tests/config/``, where the test config's tuned file and preregistration live;
     caches and build files aside) to ``dest`` (replaced); the copy's Snakefile."""
     root, dest = Path(root), Path(dest)
@@ -281,7 +282,8 @@ def copy_workflow(root: str | os.PathLike, dest: str | os.PathLike) -> Path:
     dest.mkdir(parents=True)
     shutil.copy2(root / "Snakefile", dest / "Snakefile")
     ignore = shutil.ignore_patterns("__pycache__", "*.pyc", "*.egg-info", "*.nbi", "*.nbc")
-    for sub in ("workflow", "config", "src", "paper/exploratory", "tests/config"):
+    subs = ("workflow", "config", "src", "paper/exploratory", "paper/superseded", "tests/config")
+    for sub in subs:
         if (root / sub).is_dir():
             shutil.copytree(root / sub, dest / sub, ignore=ignore)
     return dest / "Snakefile"

@@ -22,12 +22,18 @@ same hypotheses, so their differences are the optimiser's alone.
 
 Tuning rule (:func:`select`)
 ----------------------------
-For every model, family and budget b (ms of planning wall time per step, measured by the
-interleaved timing on the tuning machine): among the family's candidates whose median time per
-step is at most b, the one with the lowest mean closed-loop location error over the tuning
-runs; ties go to the candidate with less work (model steps per step), then to the first in
-candidate order. A family with no candidate within b has no member at b. The baseline (NBO)
-is not tuned: every comparison is against the Monte-Carlo member at the same budget.
+A candidate's cost per step is the larger of two wall-clock times on the tuning machine: the
+median of its interleaved timing (the same belief states for every candidate) and the mean
+planning time per step of its own closed-loop tuning runs. The second counts what the
+closed loop spends: a planner that tracks the target optimises harder there (more iterations
+per restart) than at the timing's belief states, up to ten times the median on
+``footprint150`` (the first confirmatory run, preregistration ``b0974d7f``, budgeted on the
+median alone). For every model, family and budget b (ms per step): among the family's
+candidates whose cost is at most b, the one with the lowest mean closed-loop location error
+over the tuning runs; ties go to the candidate with less work (model steps per step), then to
+the first in candidate order. A family with no candidate within b has no member at b. The
+baseline (NBO) is not tuned: every comparison is against the Monte-Carlo member at the same
+budget.
 
 Preregistration (:class:`Preregistration`)
 -----------------------------------------
@@ -57,6 +63,7 @@ from rsmhp.uav import methods
 from rsmhp.uav.methods.base import Method
 
 __all__ = [
+    "CONFIRM_STREAMS",
     "STREAMS",
     "Configuration",
     "Preregistration",
@@ -70,13 +77,18 @@ __all__ = [
 ]
 
 #: the seed streams of the protocol (:func:`stream_seed`)
-STREAMS = ("exploratory", "tune", "confirm")
+STREAMS = ("exploratory", "tune", "confirm", "confirm2")
+
+#: the streams a preregistration may name: ``confirm`` (first confirmatory run) and
+#: ``confirm2`` (the second, after the budget rule changed: a stream its design never saw)
+CONFIRM_STREAMS = ("confirm", "confirm2")
 
 
 def stream_seed(seed: int, stream: str) -> int:
-    """The root seed of ``stream``: ``seed`` itself for ``exploratory``; for ``tune`` and
-    ``confirm`` the first 63 bits of BLAKE2b-64 of ``"<seed>/<stream>"`` (independent of
-    ``seed`` and of each other as far as any test can tell)."""
+    """The root seed of ``stream``: ``seed`` itself for ``exploratory``; for the others
+    (``tune``, ``confirm``, ``confirm2``) the first 63 bits of BLAKE2b-64 of
+    ``"<seed>/<stream>"`` (independent of ``seed`` and of each other as far as any test can
+    tell)."""
     seed = guards.nonneg_int("seed", seed)
     if stream not in STREAMS:
         raise ValueError(f"stream: {stream!r} (allowed: {', '.join(STREAMS)})")
@@ -192,6 +204,8 @@ SELECTION_COLUMNS = [
     "plan_ms",
     "work_per_step",
     "mean_error",
+    "timing_ms",
+    "closed_loop_ms",
     "fitting",
 ]
 
@@ -203,14 +217,21 @@ def select(
     budgets_ms: Sequence[float],
 ) -> pd.DataFrame:
     """The tuning rule of the module docstring: one row per (model, family, budget) with a
-    candidate within the budget (:data:`SELECTION_COLUMNS`; ``fitting`` = how many of the
-    family's candidates fitted). ``quality``: closed-loop rows with ``model``, ``config``,
-    ``run``, ``mean_error``, ``work_per_step``; ``timing``: rows with ``model``, ``config``,
-    ``ms`` (interleaved calls). A configuration without rows is refused, naming it."""
+    candidate within the budget (:data:`SELECTION_COLUMNS`: ``plan_ms`` = the cost the rule
+    compares with the budget, max(``timing_ms``, ``closed_loop_ms``); ``fitting`` = how many
+    of the family's candidates fitted). ``quality``: closed-loop rows with ``model``,
+    ``config``, ``run``, ``mean_error``, ``work_per_step``, ``plan_ms`` (the run's planning
+    ms per step); ``timing``: rows with ``model``, ``config``, ``ms`` (interleaved calls). A
+    configuration without rows is refused, naming it."""
+    missing = {"model", "config", "run", "mean_error", "work_per_step", "plan_ms"} - set(quality)
+    if missing:
+        raise ValueError(f"tuning: closed-loop rows lack columns {sorted(missing)}")
     order = {c.name: i for i, c in enumerate(configs)}
     by_name = {c.name: c for c in configs}
     q = quality.groupby(["model", "config"], sort=False).agg(
-        mean_error=("mean_error", "mean"), work_per_step=("work_per_step", "median")
+        mean_error=("mean_error", "mean"),
+        work_per_step=("work_per_step", "median"),
+        closed_loop_ms=("plan_ms", "mean"),
     )
     t = timing.groupby(["model", "config"], sort=False)["ms"].median()
     rows = []
@@ -219,10 +240,13 @@ def select(
             for what, table in (("closed-loop", q), ("timing", t)):
                 if (model, c.name) not in table.index:
                     raise ValueError(f"tuning: no {what} rows of {c.name!r} on {model!r}")
+        loop = q["closed_loop_ms"]
+        cost = {c.name: max(float(t.loc[(model, c.name)]), float(loop.loc[(model, c.name)]))
+                for c in configs}  # fmt: skip
         for family in dict.fromkeys(c.family for c in configs):
             fam = [c.name for c in configs if c.family == family]
             for b in budgets_ms:
-                fit = [n for n in fam if t.loc[(model, n)] <= b]
+                fit = [n for n in fam if cost[n] <= b]
                 if not fit:
                     continue
                 best = min(
@@ -243,9 +267,11 @@ def select(
                         "member": c.member,
                         "maxiter": c.maxiter,
                         "restarts": c.restarts,
-                        "plan_ms": float(t.loc[(model, best)]),
+                        "plan_ms": cost[best],
                         "work_per_step": float(q.loc[(model, best), "work_per_step"]),
                         "mean_error": float(q.loc[(model, best), "mean_error"]),
+                        "timing_ms": float(t.loc[(model, best)]),
+                        "closed_loop_ms": float(q.loc[(model, best), "closed_loop_ms"]),
                         "fitting": len(fit),
                     }
                 )
@@ -269,6 +295,8 @@ def tuned_document(selection: pd.DataFrame, provenance: Mapping[str, Any]) -> di
             "restarts": int(r.restarts),
             "tuning": {
                 "plan_ms": round(float(r.plan_ms), 4),
+                "timing_ms": round(float(r.timing_ms), 4),
+                "closed_loop_ms": round(float(r.closed_loop_ms), 4),
                 "work_per_step": round(float(r.work_per_step), 1),
                 "mean_error": round(float(r.mean_error), 4),
                 "candidates_within_budget": int(r.fitting),
@@ -324,10 +352,11 @@ class Preregistration:
         missing = [k for k in cls.REQUIRED if k not in doc]
         if missing:
             raise ValueError(f"preregistration {path}: missing {', '.join(missing)}")
-        if doc["stream"] != "confirm":
+        if doc["stream"] not in CONFIRM_STREAMS:
             raise ValueError(
-                f"preregistration {path}: stream {doc['stream']!r} (allowed: 'confirm': the "
-                "verdicts come from the confirmatory stream only)"
+                f"preregistration {path}: stream {doc['stream']!r} (allowed: "
+                f"{', '.join(map(repr, CONFIRM_STREAMS))}: the verdicts come from a "
+                "confirmatory stream only)"
             )
         runs = doc["runs"]
         per = runs if isinstance(runs, dict) else dict.fromkeys(doc["models"], runs)
@@ -389,30 +418,26 @@ def power_runs(sd: float, effect: float, power: float = 0.8, cap: int | None = N
 
 def file_commit(path: str | Path) -> str:
     """The last commit that changed ``path`` (``git log -1``), ``"uncommitted"`` if the file
-    differs from it or was never committed, ``"unknown"`` outside a git checkout."""
+    differs from it or was never committed, ``"unknown"`` outside a git checkout (or without
+    git). ``path`` is resolved first (``a/b/../c`` is ``a/c``); a file that does not exist is
+    refused, naming it (a wrong path must not pass as "outside git")."""
     import subprocess
 
-    p = Path(path)
-    try:
-        out = subprocess.run(
-            ["git", "log", "-1", "--format=%H", "--", p.name],
-            cwd=p.parent,
-            capture_output=True,
-            text=True,
-            check=True,
-            timeout=30,
-        ).stdout.strip()
-        dirty = subprocess.run(
-            ["git", "status", "--porcelain", "--", p.name],
-            cwd=p.parent,
-            capture_output=True,
-            text=True,
-            check=True,
-            timeout=30,
-        ).stdout.strip()
-    except (OSError, subprocess.SubprocessError):
-        return "unknown"
-    return out if out and not dirty else "uncommitted"  # fmt: skip
+    p = Path(path).resolve()
+    if not p.is_file():
+        raise FileNotFoundError(f"file_commit: {path} (resolved: {p}) does not exist")
+    out = []
+    for cmd in (["git", "log", "-1", "--format=%H", "--", p.name],
+                ["git", "status", "--porcelain", "--", p.name]):  # fmt: skip
+        try:
+            res = subprocess.run(cmd, cwd=p.parent, capture_output=True, text=True, timeout=60)
+        except (OSError, subprocess.SubprocessError):
+            return "unknown"
+        if res.returncode != 0:
+            return "unknown"  # not a git checkout
+        out.append(res.stdout.strip())
+    commit, dirty = out
+    return commit if commit and not dirty else "uncommitted"
 
 
 def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, Any] | None:
@@ -444,6 +469,7 @@ def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, 
         "preregistration": dict(pre.doc),
         "path": str(conf["preregistration"]),
         "sha256": pre.sha256,
+        "stream": str(pre.doc["stream"]),
         "tuned": tuned,
         "tuned_sha256": file_sha256(tuned_path),
         "models": models,

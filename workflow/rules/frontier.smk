@@ -281,6 +281,11 @@ with open(
     os.path.join(workflow.basedir, "paper/exploratory/claims_76a0c01.json")
 ) as _f:
     EXPLORATORY_CLAIMS = json.load(_f)["claims"]
+# the first confirmatory run's FR claims (superseded by the second preregistration; kept)
+with open(
+    os.path.join(workflow.basedir, "paper/superseded/claims_confirm1.json")
+) as _f:
+    SUPERSEDED = json.load(_f)
 
 
 rule frontier_confirm:
@@ -303,6 +308,7 @@ rule frontier_confirm:
         models=canonical(config["decisions"]["uav"]["models"]),
         plan=lambda w: CONFIRM["plans"][w.model],
         runs=lambda w: CONFIRM["runs"][w.model],
+        stream=CONFIRM["stream"] if CONFIRM is not None else None,
         track_loss_error=FRONTIER["track_loss_error"],
         seed=config["seed"],
         code=code_digest("workflow/scripts/frontier_confirm.py"),
@@ -329,6 +335,7 @@ rule frontier_confirm_timing:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         models=canonical(config["decisions"]["uav"]["models"]),
         plan=lambda w: CONFIRM["plans"][w.model],
+        stream=CONFIRM["stream"] if CONFIRM is not None else None,
         timing=canonical(FRONTIER["confirm"]["timing"]),
         seed=config["seed"],
         code=code_digest("workflow/scripts/frontier_confirm_timing.py"),
@@ -361,6 +368,7 @@ rule frontier_confirm_summary:
         timing=canonical(FRONTIER["confirm"]["timing"]),
         # the FR and HZ claims published at 76a0c01 (exploratory; kept, not counted)
         exploratory=EXPLORATORY_CLAIMS,
+        superseded=SUPERSEDED,
         code=code_digest("workflow/scripts/frontier_confirm_summary.py"),
     script:
         "../scripts/frontier_confirm_summary.py"

@@ -15,7 +15,7 @@ with rule_logging(snakemake):
         snakemake.wildcards.model,
         configs,
         range(int(p.runs)),
-        stream_seed(p.seed, "confirm"),
+        stream_seed(p.seed, p.stream),
         p.track_loss_error,
     )
     write_csv(table, snakemake.output[0])

@@ -42,9 +42,19 @@ with rule_logging(snakemake) as log:
     claims = confirm_claims(runs, summary, lad, pre, chosen, c["sha256"])
     tables = confirm_tables(summary, lad, c["tuned"])
     exploratory = snakemake.params.exploratory
-    commit = file_commit(Path(snakemake.scriptdir).parents[1] / c["path"])
+    commit = file_commit(Path(snakemake.scriptdir).resolve().parents[1] / c["path"])
     meta = {"path": c["path"], "sha256": c["sha256"], "commit": commit}
-    section = confirm_section(summary, lad, claims, tables, pre, meta, c["tuned"], exploratory)
+    section = confirm_section(
+        summary,
+        lad,
+        claims,
+        tables,
+        pre,
+        meta,
+        c["tuned"],
+        exploratory,
+        superseded=snakemake.params.superseded,
+    )
     write_csv(summary, snakemake.output.summary)
     write_csv(lad, snakemake.output.ladder)
     for path in snakemake.output.tables:

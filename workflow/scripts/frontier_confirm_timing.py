@@ -15,6 +15,6 @@ with rule_logging(snakemake):
         snakemake.wildcards.model,
         configs,
         p.timing,
-        stream_seed(p.seed, "confirm"),
+        stream_seed(p.seed, p.stream),
     )
     write_csv(table, snakemake.output[0])

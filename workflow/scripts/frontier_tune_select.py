@@ -42,8 +42,10 @@ with rule_logging(snakemake) as log:
             "runs per candidate": int(p.tuning["runs"]),
             "candidates": len(tuned),
             "rule": "per model, family and budget: the lowest mean closed-loop error over the "
-            "tuning runs among the family's candidates whose median interleaved planning time "
-            "per step is within the budget (ties: less work, then candidate order)",
+            "tuning runs among the family's candidates whose planning cost per step is within "
+            "the budget; cost = the larger of the median interleaved planning time and the "
+            "mean planning time per step of the candidate's own closed-loop tuning runs (ties: "
+            "less work, then candidate order)",
             **{k: prov[k] for k in prov if k not in ("host",)},
         },
     )

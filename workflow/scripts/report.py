@@ -34,7 +34,7 @@ with rule_logging(snakemake) as log:
     summary = {k: v for k, v in prov.items() if k not in ("host", "date (UTC)", "code")}
     pre = dict(snakemake.params.preregistration)
     if pre:
-        pre["commit"] = file_commit(Path(snakemake.scriptdir).parents[1] / pre["path"])
+        pre["commit"] = file_commit(Path(snakemake.scriptdir).resolve().parents[1] / pre["path"])
         summary["preregistration"] = (
             f"{pre['path']} sha256 {pre['sha256']} (commit {pre['commit']})"
         )

@@ -282,6 +282,7 @@ def _ladder_table(lad: pd.DataFrame) -> str:
             "family": lad["family"].map(lambda f: labels.get(f, f)),
             "tuned configuration": lad["config"],
             "ms/step": lad["plan_ms"],
+            "closed-loop ms/step": lad["loop_ms"],
             "within": ["yes" if w else "no" for w in lad["within_budget"]],
             "model steps/step": lad["work_per_step"].round(0),
             "error (m)": lad["mean_error"],
@@ -310,6 +311,8 @@ def _tuning_table(tuned: Mapping[str, Any]) -> str:
                         "maxiter": "—" if e.get("maxiter") is None else int(e["maxiter"]),
                         "restarts": int(e.get("restarts", 0)),
                         "tuning ms/step": t.get("plan_ms", float("nan")),
+                        "timed": t.get("timing_ms", float("nan")),
+                        "closed loop": t.get("closed_loop_ms", float("nan")),
                         "tuning error (m)": t.get("mean_error", float("nan")),
                         "candidates within budget": t.get("candidates_within_budget", 0),
                     }
@@ -380,6 +383,41 @@ def _exploratory_table(exploratory: Sequence[Mapping[str, Any]]) -> str:
     return markdown_table(t)
 
 
+def _headline_compute(lad: pd.DataFrame, budget: float) -> str:
+    """What the members at the claims' budget spent in this run's closed loop (ms per step,
+    the mean over runs), and which of them went over the budget on the tuning rule's cost."""
+    at = lad[lad["budget_ms"] == budget]
+    if at.empty:
+        return ""
+    labels = {c.family: c.family_label for c in registry.families()}
+    parts = []
+    for model, g in at.groupby("model", sort=False):
+        spent = ", ".join(
+            f"{labels.get(r.family, r.family)} {fmt(float(r.loop_ms), 3)}" for r in g.itertuples()
+        )
+        over = [labels.get(r.family, r.family) for r in g.itertuples() if not r.within_budget]
+        parts.append(
+            f"'{model}': {spent}"
+            + (f" (over the budget here: {', '.join(over)})" if over else " (all within it)")
+        )
+    return (
+        f"Closed-loop planning ms per step of the members at {param_text(budget)} ms (mean over "
+        f"runs; the timed medians are in the appendix): {'; '.join(parts)}. "
+    )
+
+
+def _superseded_text(sup: Mapping[str, Any]) -> list[str]:
+    pre = sup.get("preregistration", {})
+    return [
+        "",
+        f"An earlier confirmatory run (preregistration sha256 {str(pre.get('sha256', '?'))[:12]}, "
+        f"commit {str(pre.get('commit', '?'))[:10]}; superseded, not counted): "
+        f"{sup.get('what', '')}",
+        "",
+        _exploratory_table(sup.get("claims", [])),
+    ]
+
+
 def confirm_section(
     summary: pd.DataFrame,
     lad: pd.DataFrame,
@@ -389,11 +427,14 @@ def confirm_section(
     prereg_meta: Mapping[str, str],
     tuned: Mapping[str, Any],
     exploratory: Sequence[Mapping[str, Any]],
+    superseded: Mapping[str, Any] | None = None,
 ) -> Section:
     """The equal-compute study's report section (order 32) from the confirmatory run of the
     protocol (:mod:`rsmhp.protocol`): ``prereg`` the preregistration's content and
     ``prereg_meta`` its path, sha256 and commit; ``tuned`` the tuned file; ``exploratory``
-    the FR and HZ claims published at 76a0c01 (kept, not counted)."""
+    the FR and HZ claims published at 76a0c01 (kept, not counted); ``superseded`` an earlier
+    confirmatory run's record (``what``, ``preregistration``, ``claims``: kept, not
+    counted)."""
     prov = tuned.get("provenance", {})
     runs = prereg["runs"]
     per = runs if isinstance(runs, Mapping) else dict.fromkeys(prereg["models"], runs)
@@ -404,16 +445,19 @@ def confirm_section(
         "(every sampled-cost member with every optimiser budget: iterations and restarts; "
         "tree searches with several widening and UCB constants) in "
         f"{prov.get('runs per candidate', '?')} closed-loop runs each and in an interleaved "
-        "timing; per model, family and budget the rule picks the lowest tuning error within "
-        f"the budget ({prov.get('date (UTC)', '?')}, commit "
+        "timing; per model, family and budget the rule picks the lowest tuning error among "
+        "the candidates whose cost per step is within the budget, the cost being the larger "
+        "of the median interleaved time and the mean time per step of the candidate's own "
+        f"closed-loop tuning runs ({prov.get('date (UTC)', '?')}, commit "
         f"{str(prov.get('commit', '?'))[:10]}; `config/tuned.yaml`). **Preregistration**: "
         f"`{prereg_meta['path']}` (sha256 {prereg_meta['sha256'][:12]}, commit "
         f"{prereg_meta['commit'][:10]}) fixes the members, budgets "
         f"({', '.join(param_text(float(b)) for b in prereg['budgets_ms'])} ms of planning per "
         f"step, wall clock on the tuning machine; the claims at "
         f"{param_text(float(prereg['headline_budget_ms']))} ms), the rules and the run counts "
-        f"({runs_text}; {prereg.get('power_text', '')}) before the **confirmatory run**, on a "
-        "third stream, which gives every number below. Times are remeasured here "
+        f"({runs_text}; {prereg.get('power_text', '')}) before the **confirmatory run**, on "
+        f"a stream of its own ('{prereg.get('stream', 'confirm')}'), which gives every number "
+        "below. Times are remeasured here "
         "(interleaved, round robin, a job holding the cores); model steps (one step of one "
         "covariance recursion) do not depend on the machine."
     )
@@ -428,6 +472,7 @@ def confirm_section(
             setting,
             "",
             (f"Preregistered claims (before Holm's correction): {found}. " if fr else "")
+            + _headline_compute(lad, float(prereg["headline_budget_ms"]))
             + _best_per_budget(lad),
             "",
             "![Confirmatory ladder](figures/dec_confirm.png)",
@@ -481,6 +526,7 @@ def confirm_section(
             "kept for the record, not counted):",
             "",
             _exploratory_table(exploratory),
+            *(_superseded_text(superseded) if superseded else []),
         ]
     )
     return Section(
