@@ -472,6 +472,14 @@ def confirm_section(
             setting,
             "",
             (f"Preregistered claims (before Holm's correction): {found}. " if fr else "")
+            + (
+                "Holm's correction (in the ledger) runs over every FR and HZ claim whose verdict "
+                "comes from a test with a p-value; HZ-4 (a bootstrap interval over replicates) "
+                "and HZ-5 (agreement with a closed form) have none and stay outside the family, "
+                "a narrowing of the preregistration's 'every FR and HZ claim'. "
+                if fr
+                else ""
+            )
             + _headline_compute(lad, float(prereg["headline_budget_ms"]))
             + _best_per_budget(lad),
             "",
