@@ -376,6 +376,28 @@ def test_confirm_summary_ladder_and_claims_follow_the_data():
     assert claims["FR-1-m"].contrary == ""
 
 
+def test_confirm_figure_plots_the_cost_the_budget_counts():
+    import matplotlib.pyplot as plt
+
+    from rsmhp.analysis.frontier import ladder, summarize_configs
+    from rsmhp.figures.frontier import confirm_figure
+
+    runs, timing, chosen = _confirm_tables()
+    lad = ladder(runs, summarize_configs(runs, timing), chosen, [0.5, 2.0])
+    fig = confirm_figure(lad)
+    try:
+        ax = fig.axes[0]
+        sigma = lad[lad.family == "sigma"].sort_values("budget_ms")
+        want = np.fmax(sigma["plan_ms"], sigma["loop_ms"]).to_numpy()
+        # the sigma points' closed loop (0.8 ms) is counted, not their timed 0.2 ms
+        assert want == pytest.approx([0.8, 0.8], abs=0.01)
+        xs = [np.asarray(line.get_xdata(), float) for line in ax.get_lines()]
+        assert any(x.shape == want.shape and np.allclose(x, want) for x in xs)
+        assert "budget's count" in ax.get_xlabel()
+    finally:
+        plt.close(fig)
+
+
 def test_confirm_section_reads_its_numbers_from_the_tables():
     from rsmhp.analysis.frontier import ladder, summarize_configs
     from rsmhp.claims.frontier import confirm_claims

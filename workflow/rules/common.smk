@@ -13,6 +13,9 @@ THREADS = config["threads"]
 # pool start-up and serial parts) declare one thread (measured with the default config, -j1
 # and -j2 runs of one machine).
 PRIORITY = {
+    # jobs that hold both cores (threads: 2) start first, while nothing else runs: at the end
+    # they would wait for both cores and leave one idle before and after them
+    "holds_cores": 2000,
     "estimators_ablation": 1000,
     "decisions_uav": 990,
     "decisions_frontier": 980,

@@ -73,7 +73,7 @@ rule decisions_frontier_timing:
         "results/logs/decisions_frontier_timing/{model}.log",
     benchmark:
         "results/benchmarks/decisions_frontier_timing/{model}.tsv"
-    priority: PRIORITY["decisions_frontier"]
+    priority: PRIORITY["holds_cores"]
     conda:
         ENV
     # the job plans on one thread but holds two: on the 2-core reference machine nothing runs
@@ -224,6 +224,7 @@ rule frontier_tune_timing:
         "results/logs/frontier_tune_timing/{model}.log",
     benchmark:
         "results/benchmarks/frontier_tune_timing/{model}.tsv"
+    priority: PRIORITY["holds_cores"]
     conda:
         ENV
     # plans on one thread but holds two: nothing runs beside it on the 2-core machine
@@ -324,6 +325,7 @@ rule frontier_confirm_timing:
         "results/logs/frontier_confirm_timing/{model}.log",
     benchmark:
         "results/benchmarks/frontier_confirm_timing/{model}.tsv"
+    priority: PRIORITY["holds_cores"]
     conda:
         ENV
     # plans on one thread but holds two: nothing runs beside it on the 2-core machine

@@ -107,7 +107,7 @@ rule horizon_lqg_estimators:
         "results/logs/horizon_lqg_estimators.log",
     benchmark:
         "results/benchmarks/horizon_lqg_estimators.tsv"
-    priority: PRIORITY["horizon_lqg"]
+    priority: PRIORITY["holds_cores"]
     conda:
         ENV
     threads: 2

@@ -473,20 +473,26 @@ def confirm_section(
             "",
             (f"Preregistered claims (before Holm's correction): {found}. " if fr else "")
             + (
-                "Holm's correction (in the ledger) runs over every FR and HZ claim whose verdict "
-                "comes from a test with a p-value; HZ-4 (a bootstrap interval over replicates) "
-                "and HZ-5 (agreement with a closed form) have none and stay outside the family, "
-                "a narrowing of the preregistration's 'every FR and HZ claim'. "
+                "Holm's correction (ledger) spans the FR and HZ claims with a test's p-value; "
+                "HZ-4 and HZ-5 (a bootstrap interval, a closed form) have none and stay "
+                "outside, narrowing the preregistration's 'every FR and HZ claim'. "
                 if fr
                 else ""
             )
             + _headline_compute(lad, float(prereg["headline_budget_ms"]))
-            + _best_per_budget(lad),
+            + (
+                "A first confirmatory run, budgeted on the timed medians alone, is superseded "
+                "(appendix: why, and its claims, not counted)."
+                if superseded
+                else ""
+            ),
             "",
             "![Confirmatory ladder](figures/dec_confirm.png)",
             "",
             "*Tuned members along the budget ladder, one line per family: closed-loop error − "
-            "NBO's against planning ms per step (top) and model steps per step (middle); "
+            "NBO's against planning ms per step as the budget counts it (top: the larger of the "
+            "timed median and the closed loop's mean; hollow: the closed loop's) and model "
+            "steps per step (middle); "
             "probability of improvement over the Monte-Carlo member at the same budget "
             "(bottom); bars: 95% t CIs over runs.*",
         ]
@@ -516,6 +522,8 @@ def confirm_section(
             "What the tuning chose (tuning stream; the numbers the rule saw):",
             "",
             tables["dec_confirm_tuning"],
+            "",
+            _best_per_budget(lad),
             "",
             (
                 f"Tree search: {len(dpw)} tuned configurations; their plans take "
