@@ -431,6 +431,28 @@ def test_horizon_outputs(run_j2, tiny):
     assert "Runs needed (closed loop; table hz_uav_closed" in appendix
 
 
+def test_scenarios_outputs(run_j2, tiny):
+    """The summary across scenarios: one row per (map cell or model and H, method) with its
+    paired runs, the per-group summary, its section after the long-horizon ones, the figure
+    and tables."""
+    per = pd.read_csv(run_j2 / "results/scenarios/per_scenario.csv")
+    cells = len(tiny["decisions"]["map"]["rows"]["values"]) * len(
+        tiny["decisions"]["map"]["cols"]["values"]
+    )
+    hz = len(tiny["horizon"]["uav"]["models"]) * len(tiny["horizon"]["uav"]["H"])
+    assert per["scenario"].nunique() == cells + hz
+    assert "nbo" not in set(per["method"]) and per["p_improve"].between(0, 1).all()
+    summary = pd.read_csv(run_j2 / "results/scenarios/summary.csv")
+    assert (summary["low"] <= summary["p_improve"]).all()
+    report = (run_j2 / "results/paper/replication.md").read_text()
+    assert report.index("## Optimiser error apart") < report.index("## Across scenarios")
+    assert "](figures/scn_improvement.png)" in report
+    assert (run_j2 / "results/paper/figures/scn_improvement.png").read_bytes()[:4] == b"\x89PNG"
+    appendix = (run_j2 / "results/paper/appendix.md").read_text()
+    for table in ("scn_improvement", "scn_per_scenario"):
+        assert (run_j2 / f"results/tables/{table}.md").read_text().strip() in appendix
+
+
 def test_horizon_lqg_outputs(run_j2, tiny):
     """Oven LQG at long horizons: estimator and regret rows, their summaries, HZ-4/HZ-5 in the
     report with their rules, the figure."""
@@ -601,7 +623,7 @@ def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, 
     captions = sorted((ROOT / "workflow/report").glob("*.rst"))
     figures = [p.stem for p in (run_j2 / "results/figures").glob("*.png")]
     tables = [p.stem for p in (run_j2 / "results/tables").glob("*.md")]
-    assert len(figures) == 24 and len(tables) == 28
+    assert len(figures) == 25 and len(tables) == 30
     assert {c.stem for c in captions} == set(figures) | {f"table_{t}" for t in tables}
     for name in figures:
         assert f"{name}.png" in html, name

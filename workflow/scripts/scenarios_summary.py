@@ -1,0 +1,38 @@
+"""Rule scenarios_summary: the probability of beating NBO per scenario and method, its
+average per group of scenarios, the tables and the report section."""
+
+from pathlib import Path
+
+import pandas as pd
+
+from rsmhp.analysis.scenarios import improvement_summary, per_scenario, scenario_runs
+from rsmhp.io import read_table, write_csv, write_text
+from rsmhp.narrative.scenarios import scenarios_section, scenarios_tables
+from rsmhp.pipeline import rule_logging
+
+MAP_COLUMNS = ["cell", "row_value", "col_value", "method", "run", "mean_error"]
+CLOSED_COLUMNS = ["model", "H", "method", "run", "mean_error"]
+
+with rule_logging(snakemake) as log:
+    p = snakemake.params
+    inp = snakemake.input
+    map_runs = (
+        pd.concat([read_table(f, MAP_COLUMNS) for f in inp.map_runs], ignore_index=True)
+        if inp.map_runs
+        else None
+    )
+    closed = (
+        pd.concat([read_table(f, CLOSED_COLUMNS) for f in inp.closed], ignore_index=True)
+        if inp.closed
+        else None
+    )
+    runs = scenario_runs(map_runs, closed)
+    per = per_scenario(runs)
+    summary = improvement_summary(runs, n_boot=int(p.n_boot), seed=int(p.seed))
+    tables = scenarios_tables(summary, per)
+    write_csv(per, snakemake.output.per_scenario)
+    write_csv(summary, snakemake.output.summary)
+    for path in snakemake.output.tables:
+        write_text(tables[Path(path).stem] + "\n", path)
+    scenarios_section(summary, tables).save(snakemake.output.section)
+    log.info("%d scenario rows, %d summary rows", len(per), len(summary))
