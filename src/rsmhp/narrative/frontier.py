@@ -401,8 +401,8 @@ def _headline_compute(lad: pd.DataFrame, budget: float) -> str:
             + (f" (over the budget here: {', '.join(over)})" if over else " (all within it)")
         )
     return (
-        f"Closed-loop planning ms per step of the members at {param_text(budget)} ms (mean over "
-        f"runs; the timed medians are in the appendix): {'; '.join(parts)}. "
+        f"Closed-loop ms per step at {param_text(budget)} ms (mean over runs): "
+        f"{'; '.join(parts)}. "
     )
 
 
@@ -473,16 +473,15 @@ def confirm_section(
             "",
             (f"Preregistered claims (before Holm's correction): {found}. " if fr else "")
             + (
-                "Holm's correction (ledger) spans the FR and HZ claims with a test's p-value; "
-                "HZ-4 and HZ-5 (a bootstrap interval, a closed form) have none and stay "
-                "outside, narrowing the preregistration's 'every FR and HZ claim'. "
+                "Holm (ledger) spans the FR and HZ claims with a p-value; HZ-4 and HZ-5 have "
+                "none (narrower than preregistered). "
                 if fr
                 else ""
             )
             + _headline_compute(lad, float(prereg["headline_budget_ms"]))
             + (
-                "A first confirmatory run, budgeted on the timed medians alone, is superseded "
-                "(appendix: why, and its claims, not counted)."
+                "A first confirmatory run (budgeted on timed medians) is superseded: appendix, "
+                "not counted."
                 if superseded
                 else ""
             ),

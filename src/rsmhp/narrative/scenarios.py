@@ -71,12 +71,11 @@ def scenarios_section(summary: pd.DataFrame, tables: dict[str, str]) -> Section:
         body = "No scenario has paired closed-loop runs of a method and NBO."
     else:
         body = (
-            "Probability that a method's closed-loop run beats NBO's paired run, averaged over "
-            "scenarios (95% stratified bootstrap; 0.5: no difference; descriptive; every "
-            "method in the appendix): "
+            "P(a method's closed-loop run beats NBO's paired run), mean over scenarios, 95% "
+            "stratified bootstrap, descriptive (all methods in the appendix): "
             + "; ".join(_group_text(summary, g) for g in groups)
-            + ". It counts wins, not metres: where the errors differ by centimetres (UAV-2) a "
-            "method can win most runs and still be equivalent."
+            + ". Wins, not metres: a method can win most runs by centimetres (UAV-2: "
+            "equivalent)."
         )
     appendix = "\n".join(
         [
@@ -99,8 +98,8 @@ def scenarios_section(summary: pd.DataFrame, tables: dict[str, str]) -> Section:
         title="Across scenarios: probability of beating NBO",
         order=ORDER,
         body=body + "\n\n![Probability of beating NBO](figures/scn_improvement.png)\n\n"
-        "*Per method, the probability of beating NBO run by run, averaged over each group of "
-        "scenarios; bars: 95% stratified bootstrap intervals; dashed: 0.5.*",
+        "*P(run beats NBO's paired run) per method and group of scenarios; bars: 95% "
+        "stratified bootstrap.*",
         figures=["scn_improvement"],
         appendix=appendix,
     )
