@@ -401,8 +401,7 @@ def _headline_compute(lad: pd.DataFrame, budget: float) -> str:
             + (f" (over the budget here: {', '.join(over)})" if over else " (all within it)")
         )
     return (
-        f"Closed-loop ms per step at {param_text(budget)} ms (mean over runs): "
-        f"{'; '.join(parts)}. "
+        f"Closed-loop ms per step at {param_text(budget)} ms (mean over runs): {'; '.join(parts)}. "
     )
 
 

@@ -72,10 +72,9 @@ def scenarios_section(summary: pd.DataFrame, tables: dict[str, str]) -> Section:
     else:
         body = (
             "P(a method's closed-loop run beats NBO's paired run), mean over scenarios, 95% "
-            "stratified bootstrap, descriptive (all methods in the appendix): "
+            "stratified bootstrap, descriptive (appendix: every method): "
             + "; ".join(_group_text(summary, g) for g in groups)
-            + ". Wins, not metres: a method can win most runs by centimetres (UAV-2: "
-            "equivalent)."
+            + ". Wins, not metres: most runs can be won by centimetres (UAV-2: equivalent)."
         )
     appendix = "\n".join(
         [
