@@ -488,9 +488,9 @@ def confirm_section(
             "![Confirmatory ladder](figures/dec_confirm.png)",
             "",
             "*Tuned members along the budget ladder, one line per family: closed-loop error − "
-            "NBO's against planning ms per step as the budget counts it (top: the larger of the "
-            "timed median and the closed loop's mean; hollow: the closed loop's) and model "
-            "steps per step (middle); "
+            "NBO's against planning ms per step as the budget counts it (top: max of timed "
+            "median and closed-loop mean; hollow: the latter) and model steps per step "
+            "(middle); "
             "probability of improvement over the Monte-Carlo member at the same budget "
             "(bottom); bars: 95% t CIs over runs.*",
         ]
