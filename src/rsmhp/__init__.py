@@ -33,11 +33,12 @@ Stages of the pipeline (one module per model and stage)
   experiments       lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon,
                     horizon_lqg, optimiser_split: config -> tidy tables
   analysis          lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon,
-                    horizon_lqg, optimiser_split: tables -> statistics
-  protocol          the comparison protocol: seed streams (exploratory, tune, confirm),
-                    planner configurations, the tuning rule, the preregistration
-  figures           lqg, estimators, uav, decisions, frontier, horizon: seaborn figures (PNG
-                    + PDF)
+                    horizon_lqg, optimiser_split: tables -> statistics; scenarios: every
+                    method's probability of beating NBO across map cells and horizons
+  protocol          the comparison protocol: seed streams (exploratory, tune, confirm,
+                    confirm2), planner configurations, the tuning rule, the preregistration
+  figures           lqg, estimators, uav, decisions, frontier, horizon, optimiser_split,
+                    scenarios: seaborn figures (PNG + PDF)
   recording         rerun recordings of sampled trajectory trees
   claims            per study: the claims (key number + verdict rule) from the statistics;
                     claims.paper: the paper's statements, each with its evidence and verdict
