@@ -26,7 +26,7 @@ A candidate's cost per step is the larger of two wall-clock times on the tuning 
 median of its interleaved timing (the same belief states for every candidate) and the mean
 planning time per step of its own closed-loop tuning runs. The second counts what the
 closed loop spends: a planner that tracks the target optimises harder there (more iterations
-per restart) than at the timing's belief states, up to ten times the median on
+per restart) than at the timing's belief states, up to 13 times the median on
 ``footprint150`` (the first confirmatory run, preregistration ``b0974d7f``, budgeted on the
 median alone). For every model, family and budget b (ms per step): among the family's
 candidates whose cost is at most b, the one with the lowest mean closed-loop location error
