@@ -54,6 +54,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 import yaml
 
@@ -67,6 +68,7 @@ __all__ = [
     "STREAMS",
     "Configuration",
     "Preregistration",
+    "budget_cost",
     "candidates",
     "confirm_plan",
     "file_commit",
@@ -192,6 +194,13 @@ def candidates(cfg: Mapping[str, Any]) -> list[Configuration]:
     return out
 
 
+def budget_cost(timed_ms, loop_ms):
+    """The planning cost per step a budget counts (ms): the larger of the median interleaved
+    time and the closed loop's own mean time per step (module docstring). Floats or arrays;
+    NaN in one of them gives the other."""
+    return np.fmax(timed_ms, loop_ms)
+
+
 #: the columns of the tuning selection (:func:`select`)
 SELECTION_COLUMNS = [
     "model",
@@ -241,7 +250,7 @@ def select(
                 if (model, c.name) not in table.index:
                     raise ValueError(f"tuning: no {what} rows of {c.name!r} on {model!r}")
         loop = q["closed_loop_ms"]
-        cost = {c.name: max(float(t.loc[(model, c.name)]), float(loop.loc[(model, c.name)]))
+        cost = {c.name: float(budget_cost(t.loc[(model, c.name)], loop.loc[(model, c.name)]))
                 for c in configs}  # fmt: skip
         for family in dict.fromkeys(c.family for c in configs):
             fam = [c.name for c in configs if c.family == family]

@@ -46,6 +46,7 @@ __all__ = [
     "loglog_slope",
     "mean_ci",
     "one_sided_p_value",
+    "paired_wins",
     "probability_of_improvement",
     "rmse_ci",
     "runs_for_power",
@@ -546,8 +547,10 @@ class Improvement:
     share_above_half: float
 
 
-def _paired_wins(x: np.ndarray, y: np.ndarray) -> np.ndarray:
-    """Per pair: 1 if x < y, 1/2 if x == y, 0 otherwise (lower is better)."""
+def paired_wins(x: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """Per pair (lower is better): 1.0 if x < y, 0.5 if x == y, 0.0 otherwise; the terms
+    whose mean is the probability of improvement of x over y."""
+    x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
     return (x < y) + 0.5 * (x == y)
 
 
@@ -579,7 +582,7 @@ def probability_of_improvement(
             raise ValueError(
                 f"pairs[{i}]: x and y must be 1-D of one length >= 1, got {x.shape} and {y.shape}"
             )
-        wins.append(_paired_wins(x, y).astype(float))
+        wins.append(paired_wins(x, y))
     per = np.array([w.mean() for w in wins])
     rng = np.random.default_rng(seed)
     boot = np.zeros(n_boot)

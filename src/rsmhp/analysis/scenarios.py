@@ -19,7 +19,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from rsmhp.stats import probability_of_improvement
+from rsmhp.stats import paired_wins, probability_of_improvement
 from rsmhp.uav import methods
 
 __all__ = [
@@ -79,12 +79,21 @@ def scenario_runs(map_runs: pd.DataFrame | None, closed: pd.DataFrame | None) ->
     return out
 
 
-def _pairs(runs: pd.DataFrame, method: str, baseline: str) -> dict[tuple[str, str], tuple]:
+def _wide(runs: pd.DataFrame) -> dict[tuple[str, str], pd.DataFrame]:
+    """Per (group, scenario): its runs x methods table of mean errors."""
+    return {
+        key: g.pivot(index="run", columns="method", values="mean_error")
+        for key, g in runs.groupby(["group", "scenario"], sort=False)
+    }
+
+
+def _pairs(
+    wide: dict[tuple[str, str], pd.DataFrame], method: str, baseline: str
+) -> dict[tuple[str, str], tuple]:
     """Per (group, scenario) holding both: the paired arrays (method, baseline) over the
     runs both have, in run order."""
     out = {}
-    for key, g in runs.groupby(["group", "scenario"], sort=False):
-        w = g.pivot(index="run", columns="method", values="mean_error")
+    for key, w in wide.items():
         if method not in w or baseline not in w:
             continue
         both = w[[method, baseline]].dropna()
@@ -102,9 +111,10 @@ def per_scenario(runs: pd.DataFrame, baseline: str = "nbo") -> pd.DataFrame:
     probability that the method's run beats the baseline's (ties count 1/2) and the mean
     difference of the errors, method − baseline (m)."""
     rows = []
+    wide = _wide(runs)
     for method in _methods(runs, baseline):
-        for (group, scenario), (x, y) in _pairs(runs, method, baseline).items():
-            wins = (x < y) + 0.5 * (x == y)
+        for (group, scenario), (x, y) in _pairs(wide, method, baseline).items():
+            wins = paired_wins(x, y)
             rows.append({"group": group, "scenario": scenario, "method": method,
                          "runs": len(x), "p_improve": float(np.mean(wins)),
                          "mean_diff": float(np.mean(x - y))})  # fmt: skip
@@ -121,8 +131,9 @@ def improvement_summary(
     scenarios is there only for a method that ran in more than one group."""
     rows = []
     groups: Sequence[str] = [*dict.fromkeys(runs["group"]), ALL_GROUP]
+    wide = _wide(runs)
     for method in _methods(runs, baseline):
-        pairs = _pairs(runs, method, baseline)
+        pairs = _pairs(wide, method, baseline)
         in_groups = {g for g, _ in pairs}
         for group in groups:
             if group == ALL_GROUP and len(in_groups) < 2:

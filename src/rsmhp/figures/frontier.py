@@ -11,8 +11,8 @@ is a dotted vertical line.
 ``dec_confirm`` (:func:`confirm_figure`), the confirmatory run of the protocol: columns are
 model variants; each family's tuned members along the budget ladder as one line; rows: closed-
 loop mean location error minus NBO's (m, 95% t CIs over runs) against the planning
-milliseconds per step the budget counts (the larger of the interleaved median and the closed
-loop's own mean, :func:`rsmhp.protocol.select`; a hollow marker where the closed loop's is the
+milliseconds per step the budget counts (the ladder's ``cost_ms``,
+:func:`rsmhp.protocol.budget_cost`; a hollow marker where the closed loop's time is the
 larger), the same against model steps per planning step (machine-independent),
 and the probability of improvement over the Monte-Carlo member at the same budget (95% t CIs)
 against the budget.
@@ -116,11 +116,6 @@ def confirm_figure(lad: pd.DataFrame) -> plt.Figure:
     if not models:
         raise ValueError("ladder is empty")
     fams = {c.family: c for c in methods.families()}
-    lad = lad.copy()
-    if "loop_ms" in lad:  # the cost the budget counts (ladders before it: the timing alone)
-        lad["cost_ms"] = np.fmax(lad["plan_ms"], lad["loop_ms"])
-    else:
-        lad["cost_ms"] = lad["plan_ms"]
     rows = (
         ("cost_ms", "diff_nbo", "error − NBO's (m)", "planning ms per step (budget's count)"),
         ("work_per_step", "diff_nbo", "error − NBO's (m)", "model steps per planning step"),
@@ -151,7 +146,7 @@ def confirm_figure(lad: pd.DataFrame) -> plt.Figure:
                     lw=1.3,
                     label=fams[fam].family_label if fam in fams else fam,
                 )
-                if xcol == "cost_ms" and "loop_ms" in f:  # the closed loop's time counted
+                if xcol == "cost_ms":  # hollow where the closed loop's time is the one counted
                     loop = (f["loop_ms"] > f["plan_ms"]).to_numpy()
                     ax.scatter(f[xcol][loop], y[loop], s=30, facecolor="white", zorder=3,
                                edgecolor=fams[fam].colour if fam in fams else "0.5")  # fmt: skip

@@ -9,7 +9,7 @@ import numpy as np
 import pandas as pd
 
 from rsmhp.figures import theme
-from rsmhp.palette import method_colour, method_label
+from rsmhp.palette import method_label
 
 __all__ = ["FIGURES", "improvement_figure"]
 
@@ -42,8 +42,6 @@ def improvement_figure(summary: pd.DataFrame) -> plt.Figure:
                          g.loc[ms, "high"].to_numpy(float) - p])  # fmt: skip
         ax.errorbar(p, y, xerr=err, fmt=_MARKERS[k % len(_MARKERS)], color="0.25", ms=5,
                     capsize=2, lw=1.0, label=group, mfc="white" if k % 2 else "0.25")  # fmt: skip
-        for m, yy, pp in zip(ms, y, p, strict=True):
-            ax.plot(pp, yy, _MARKERS[k % len(_MARKERS)], ms=3, color=method_colour(m))
     ax.set_yticks(range(len(order)), [method_label(m) for m in order])
     ax.set_xlabel("P(run beats NBO's paired run)")
     ax.legend(fontsize="small", loc="lower right")
