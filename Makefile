@@ -25,7 +25,7 @@ help:
 	@echo "  make lint                  ruff, ruff format --check, snakefmt --check, snakemake --lint"
 	@echo "  make clean                 delete results/ and .snakemake/"
 	@echo "Variables: CORES=$(CORES) PYTHON=$(PYTHON) VENV=$(VENV)"
-	@echo "Check a config overlay:  $(BIN)/python -m rsmhp.config my.yaml"
+	@echo "Check a config overlay:  $(BIN)/python -m rsmhp.pipeline.config my.yaml"
 	@echo "Rules and targets (snakemake --list-rules):"
 	@test -x $(BIN)/snakemake && $(BIN)/snakemake --list-rules 2>/dev/null | sed 's/^/  /' || echo "  (run make setup first)"
 
@@ -35,7 +35,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	@# compile the numba planner kernels once per machine (on-disk cache; every job loads it)
-	$(BIN)/python -c 'from rsmhp.uav import fused; from rsmhp.experiments import decisions_lqg as d; print(f"compiled kernels ready in {fused.warm_up() + d.warm_up():.1f} s")'
+	$(BIN)/python -c 'from rsmhp.models.uav import fused; from rsmhp.experiments import decisions_lqg as d; print(f"compiled kernels ready in {fused.warm_up() + d.warm_up():.1f} s")'
 	@touch $(STAMP)
 
 setup: $(STAMP)
@@ -60,7 +60,7 @@ publish: $(STAMP)
 	mkdir -p paper/figures
 	cp results/paper/replication.md results/paper/appendix.md results/paper/claims.json paper/
 	cp results/paper/figures/*.png paper/figures/
-	$(BIN)/python -m rsmhp.readme splice README.md results/paper/glance.md
+	$(BIN)/python -m rsmhp.report.readme splice README.md results/paper/glance.md
 
 # compare a run with the committed reference paper/claims.json, claim by claim (runs what is
 # missing first); fails if a verdict flips or a key number leaves its tolerance
@@ -72,7 +72,7 @@ verify: $(STAMP)
 # writes results/portability/drill.md and drill.json; fails if a verdict differs or verify
 # fails. ARGS go to the drill: make portability ARGS="--openblas-coretype Haswell --keep"
 portability: $(STAMP)
-	$(BIN)/python -m rsmhp.portability --cores $(CORES) $(ARGS)
+	$(BIN)/python -m rsmhp.report.portability --cores $(CORES) $(ARGS)
 
 lint: $(STAMP)
 	$(BIN)/ruff check .

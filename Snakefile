@@ -4,8 +4,13 @@ import sys
 
 from snakemake.utils import min_version, update_config, validate
 
-from rsmhp.config import ConfigError, check_config, load_config_file, typed_overrides
-from rsmhp.resources import memory_problems
+from rsmhp.pipeline.config import (
+    ConfigError,
+    check_config,
+    load_config_file,
+    typed_overrides,
+)
+from rsmhp.pipeline.resources import memory_problems
 
 min_version("9.0")
 
@@ -23,7 +28,7 @@ os.environ.update(
 
 # A broken config/config.yaml is reported with its line (Snakemake only says "not valid
 # YAML"); files given with --configfile are parsed by Snakemake before this file runs:
-# `python -m rsmhp.config FILE` reports their lines.
+# `python -m rsmhp.pipeline.config FILE` reports their lines.
 # A refusal prints its message alone (it names the file, key or rule; no Python frames).
 try:
     load_config_file(os.path.join(workflow.basedir, "config", "config.yaml"))
@@ -78,7 +83,7 @@ onstart:
         workflow.executor_plugin is not None
         and workflow.executor_plugin.name == "slurm"
     ):
-        from rsmhp.cluster import ClusterFitError, JobAsk, check_jobs
+        from rsmhp.pipeline.cluster import ClusterFitError, JobAsk, check_jobs
 
         try:
             check_jobs(

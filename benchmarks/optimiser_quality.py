@@ -27,12 +27,12 @@ import yaml
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from rsmhp.seeding import job_rng  # noqa: E402
-from rsmhp.stats import bootstrap_ci  # noqa: E402
-from rsmhp.uav import methods  # noqa: E402
-from rsmhp.uav.planner import LBFGSB, Belief, BoxQN, PlanningProblem  # noqa: E402
-from rsmhp.uav.sensor import SensorModel  # noqa: E402
-from rsmhp.uav.simulation import UAVSetup, simulate_run  # noqa: E402
+from rsmhp.core.seeding import job_rng  # noqa: E402
+from rsmhp.core.stats import bootstrap_ci  # noqa: E402
+from rsmhp.models.uav import methods  # noqa: E402
+from rsmhp.models.uav.planner import LBFGSB, Belief, BoxQN, PlanningProblem  # noqa: E402
+from rsmhp.models.uav.sensor import SensorModel  # noqa: E402
+from rsmhp.models.uav.simulation import UAVSetup, simulate_run  # noqa: E402
 
 
 def _states(setup: UAVSetup, seed: int, runs: int) -> list:

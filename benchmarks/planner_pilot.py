@@ -6,7 +6,7 @@ step of every planner family at several sizes, on the decision study's belief st
 For each model variant of ``decisions.uav.models`` named, the belief states of the first
 ``--runs`` NBO closed-loop runs at ``decisions.uav.steps`` (the decision study's states and
 streams), every method below plans once and is scored exactly as ``decisions_uav`` scores
-(:func:`rsmhp.experiments.decisions_uav.score_state`: regret against the multi-start reference
+(:func:`rsmhp.models.uav.scoring.score_state`: regret against the multi-start reference
 on an independent evaluation set). Planning time per step is measured separately, in this
 process on one thread: the median over the states of the wall time of one ``plan`` call
 (after one warm-up call per method). Prints per model and method: mean relative regret (%) with
@@ -28,11 +28,11 @@ import pandas as pd
 import yaml
 from threadpoolctl import threadpool_limits
 
-from rsmhp.experiments.decisions_uav import belief_states, merge_variant, score_state
-from rsmhp.seeding import job_rng
-from rsmhp.uav import methods
-from rsmhp.uav.planner import Belief
-from rsmhp.uav.simulation import UAVSetup
+from rsmhp.core.seeding import job_rng
+from rsmhp.models.uav import methods
+from rsmhp.models.uav.planner import Belief
+from rsmhp.models.uav.scoring import belief_states, merge_variant, score_state
+from rsmhp.models.uav.simulation import UAVSetup
 
 ROOT = Path(__file__).resolve().parents[1]
 BLOCK = {

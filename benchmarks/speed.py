@@ -49,8 +49,8 @@ validate(cfg, f"{root}/workflow/schemas/config.schema.yaml")
 KERNEL = (
     COMMON
     + r"""
-from rsmhp.uav import fused
-from rsmhp.uav.simulation import UAVSetup
+from rsmhp.models.uav import fused
+from rsmhp.models.uav.simulation import UAVSetup
 setup = UAVSetup.from_config(cfg["uav"])
 T, H, C = 250, 6, 200
 rng = np.random.default_rng(0)
@@ -76,12 +76,12 @@ print(json.dumps({"module": rsmhp.__file__, "out": out}))
 LOOP = (
     COMMON
     + r"""
-from rsmhp.uav.simulation import UAVSetup, simulate_run
+from rsmhp.models.uav.simulation import UAVSetup, simulate_run
 try:  # the method registry; older checkouts had method_specs
-    from rsmhp.uav import methods as _methods
+    from rsmhp.models.uav import methods as _methods
     spec = _methods.from_config(cfg["uav"]["methods"])[sys.argv[2]]
 except ImportError:
-    from rsmhp.uav.simulation import method_specs
+    from rsmhp.models.uav.simulation import method_specs
     spec = method_specs(cfg["uav"])[sys.argv[2]]
 setup = UAVSetup.from_config(cfg["uav"])
 runs = [int(r) for r in sys.argv[3].split(",")]
@@ -101,15 +101,15 @@ RULES = (
     + r"""
 part = sys.argv[2]
 if part == "decisions_lqg":
-    from rsmhp.experiments.decisions_lqg import run_lqg_regret
+    from rsmhp.models.lqg.regret import run_lqg_regret
     small = dict(cfg["decisions"]["lqg"], replicates=2)
     run_lqg_regret(small, cfg["lqg"]["model"], cfg["seed"], n_jobs=1)  # warm-up
     t0 = time.perf_counter()
     run_lqg_regret(cfg["decisions"]["lqg"], cfg["lqg"]["model"], cfg["seed"], n_jobs=1)
     out = time.perf_counter() - t0
 else:
-    from rsmhp.experiments.decisions_uav import run_map_cell
-    from rsmhp.experiments.uav import UAV_MODEL_KEYS
+    from rsmhp.models.uav.scoring import run_map_cell
+    from rsmhp.studies.uav.simulate import UAV_MODEL_KEYS
     dec = cfg["decisions"]
     keys = ("rows", "cols", "runs", "methods", "regret_runs", "regret_steps", "track_loss_error")
     mcfg = {k: dec["map"][k] for k in keys if k in dec["map"]}
@@ -167,7 +167,7 @@ def main() -> None:
     sys.path.insert(0, str(ROOT / "src"))
     import yaml
 
-    from rsmhp.uav import methods as registry
+    from rsmhp.models.uav import methods as registry
 
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     head = f"{'':28s} {'this':>12s} {'':8s}"

@@ -3,9 +3,10 @@
 One planning step's workload: N_T target hypotheses x H steps for one control sequence,
 R evaluated from the geometry inside every kernel. Three implementations:
 
-* ``fused``: the compiled kernel (:mod:`rsmhp.uav.fused`), value, or value + exact gradient
+* ``fused``: the compiled kernel (:mod:`rsmhp.models.uav.fused`), value, or value + exact gradient
   (adjoint) in one pass;
-* ``numpy``: the vectorised numpy kernel (:mod:`rsmhp.uav.kernel`), the test oracle; before the
+* ``numpy``: the vectorised numpy kernel (:mod:`rsmhp.models.uav.kernel`), the test oracle; before
+the
   fused kernel the planner got its gradient from it as a batch of 2H + 1 = 13 candidates
   (base point and forward differences);
 * ``filterpy``: a per-trajectory loop of filterpy predict / update calls.
@@ -32,17 +33,17 @@ import time
 import numpy as np
 from threadpoolctl import threadpool_limits
 
-from rsmhp.uav import fused, kinematics, sensor
-from rsmhp.uav.kernel import objective
-from rsmhp.uav.kinematics import UAVParams
-from rsmhp.uav.sensor import SensorModel
-from rsmhp.uav.target import TargetModel
-from rsmhp.uav.tracker import Tracker
+from rsmhp.models.uav import fused, kinematics, sensor
+from rsmhp.models.uav.kernel import objective
+from rsmhp.models.uav.kinematics import UAVParams
+from rsmhp.models.uav.sensor import SensorModel
+from rsmhp.models.uav.target import TargetModel
+from rsmhp.models.uav.tracker import Tracker
 
 FIRST_CALL = """
 import time
 t0 = time.perf_counter()
-from rsmhp.uav import fused
+from rsmhp.models.uav import fused
 t1 = time.perf_counter()
 fused.warm_up()
 t2 = time.perf_counter()

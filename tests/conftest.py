@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from rsmhp.lqg import LQGModel
+from rsmhp.models.lqg.oven import LQGModel
 
 PAPER = {"x0": 0.0, "a": 0.5, "r": 10.0, "target": 1.0, "sigma": 1.0}
 PAPER_U = np.array([0.55, 0.17])
@@ -26,7 +26,7 @@ def rng() -> np.random.Generator:
 @pytest.fixture(scope="session")
 def run_j2(tmp_path_factory) -> Path:
     """The whole workflow (LQG, UAV, report) on the tiny config with -j2, run once per session."""
-    from tests.test_workflow import snakemake
+    from tests.pipeline.test_workflow import snakemake
 
     wd = tmp_path_factory.mktemp("wf_j2")
     res = snakemake(wd, "-j2")
@@ -39,6 +39,6 @@ def tiny() -> dict:
     """The tiny workflow config (tests/config/tiny.yaml) as a dict."""
     import yaml
 
-    from tests.test_workflow import TINY
+    from tests.pipeline.test_workflow import TINY
 
     return yaml.safe_load(TINY.read_text())

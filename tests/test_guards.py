@@ -15,9 +15,8 @@ import numpy as np
 import pytest
 import yaml
 
-from rsmhp import cost_estimators, designs, guards, lqg, seeding, stats
-from rsmhp.linear_quadratic import LinearQuadratic
-from rsmhp.sampling import (
+from rsmhp.core import cost_estimators, designs, guards, seeding, stats
+from rsmhp.core.sampling import (
     GaussianNoise,
     rollout,
     rollout_cost,
@@ -26,18 +25,20 @@ from rsmhp.sampling import (
     sample_tree_batch,
     top_m,
 )
-from rsmhp.uav import fused, kernel, kinematics, sensor, target
-from rsmhp.uav import methods as uav_methods
-from rsmhp.uav.kinematics import UAVParams
-from rsmhp.uav.methods.monte_carlo import MonteCarlo
-from rsmhp.uav.methods.nbo import NBO as NBOMethod
-from rsmhp.uav.methods.pruned_tree import PrunedTree
-from rsmhp.uav.planner import PlannerParams, PlanningProblem, lbfgsb, plan, shift_plan
-from rsmhp.uav.recording import ellipse_polygon
-from rsmhp.uav.sensor import SensorModel
-from rsmhp.uav.simulation import UAVSetup, draw_scenario, simulate_run
-from rsmhp.uav.target import TargetModel
-from rsmhp.uav.tracker import Tracker
+from rsmhp.models.lqg import oven as lqg
+from rsmhp.models.lqg.linear_quadratic import LinearQuadratic
+from rsmhp.models.uav import fused, kernel, kinematics, sensor, target
+from rsmhp.models.uav import methods as uav_methods
+from rsmhp.models.uav.kinematics import UAVParams
+from rsmhp.models.uav.methods.monte_carlo import MonteCarlo
+from rsmhp.models.uav.methods.nbo import NBO as NBOMethod
+from rsmhp.models.uav.methods.pruned_tree import PrunedTree
+from rsmhp.models.uav.planner import PlannerParams, PlanningProblem, lbfgsb, plan, shift_plan
+from rsmhp.models.uav.recording import ellipse_polygon
+from rsmhp.models.uav.sensor import SensorModel
+from rsmhp.models.uav.simulation import UAVSetup, draw_scenario, simulate_run
+from rsmhp.models.uav.target import TargetModel
+from rsmhp.models.uav.tracker import Tracker
 
 ROOT = Path(__file__).resolve().parents[1]
 UAV_CFG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["uav"]
@@ -996,7 +997,7 @@ def test_h_equal_one_and_numpy_integers():
 
 
 def test_whole_number_floats_are_normalised():
-    """3.0 counts as 3 (as in rsmhp.seeding's job ids); the result equals the int's."""
+    """3.0 counts as 3 (as in rsmhp.core.seeding's job ids); the result equals the int's."""
     assert lqg.state_variance(3.0, a=0.4, sigma=1.0) == lqg.state_variance(3, a=0.4, sigma=1.0)
     w, wt = designs.monte_carlo(np.random.default_rng(1), 8.0, 2, CHOL)
     w2, wt2 = designs.monte_carlo(np.random.default_rng(1), 8, 2, CHOL)

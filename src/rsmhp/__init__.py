@@ -55,7 +55,7 @@ Stages of the pipeline (one module per model and stage)
                     native run and the reference (``make portability``)
   palette           one colour and label per method, for every figure and recording
 Workflow support
-  config            config files and schema checks (``python -m rsmhp.config FILE``)
+  config            config files and schema checks (``python -m rsmhp.pipeline.config FILE``)
   resources         memory estimate of each simulation rule from the config
   contracts         what each intermediate file must hold, checked before aggregation
   io                atomic, umask-honouring writers and checked readers

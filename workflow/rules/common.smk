@@ -1,5 +1,7 @@
 # Shared settings and helpers of every rule file.
-from rsmhp.code_digest import code_digest as _code_digest
+from rsmhp.models.uav import methods as _registry
+from rsmhp.pipeline.code_digest import code_digest as _code_digest
+from rsmhp.pipeline.code_digest import method_only
 
 THREADS = config["threads"]
 
@@ -43,14 +45,27 @@ REPORT_SECTIONS = {}
 REPORT_FIGURES = []
 
 
-def code_digest(script):
+def code_digest(script, families=None):
     """The `code` param for `script` (workflow/scripts/<x>.py): the digest of that script
-    and of every rsmhp module under this workflow's src/ it can import (rsmhp.code_digest,
-    content-based, comments and formatting aside). A change to that code changes the param,
-    so Snakemake reruns the job and everything downstream."""
+    and of every rsmhp module under this workflow's src/ it can import
+    (rsmhp.pipeline.code_digest, content-based, comments and formatting aside). A change to
+    that code changes the param, so Snakemake reruns the job and everything downstream.
+    `families` (a job that runs UAV planning methods: `families_of(...)`, also its
+    `families` param) counts only those method families' modules of the registry, so adding
+    or editing another family reruns none of its jobs."""
     return _code_digest(
-        os.path.join(workflow.basedir, script), os.path.join(workflow.basedir, "src")
+        os.path.join(workflow.basedir, script),
+        os.path.join(workflow.basedir, "src"),
+        method_only(families),
     )
+
+
+def families_of(methods, key=None):
+    """Module names of the method families of `methods`: registry members, or a `methods`
+    block of the config (then `key` names it in error messages)."""
+    if isinstance(methods, dict):
+        methods = _registry.from_config(methods, key).values()
+    return sorted({type(m).__module__.rpartition(".")[2] for m in methods})
 
 
 def canonical(value):

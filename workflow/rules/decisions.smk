@@ -1,11 +1,13 @@
 # Decision-quality study: the regret of the controls each method chooses.
 # Simulation, aggregation and figures are separate rules; the sensitivity map runs one job
 # per cell (wildcard {cell} = r<i>c<j>), so a cell reruns alone and cells fan out.
-from rsmhp.narrative.decisions_lqg import FIGURES as LQG_FIGURES
-from rsmhp.narrative.decisions_uav import FIGURES as UAV_FIGURES
-from rsmhp.experiments.decisions_uav import map_cells
+from rsmhp.studies.decisions.section_lqg import FIGURES as LQG_FIGURES
+from rsmhp.studies.decisions.section_uav import FIGURES as UAV_FIGURES
+from rsmhp.models.uav.scoring import map_cells
 
 DEC = config["decisions"]
+DEC_UAV_FAMILIES = families_of(DEC["uav"]["methods"], "decisions.uav.methods")
+DEC_MAP_FAMILIES = families_of(DEC["map"]["methods"], "decisions.map.methods")
 MAP_CELLS = [c.name for c in map_cells(DEC["map"])]
 # the scoring settings of the open-loop regret, shared by the map cells
 DEC_SCORING = pick(
@@ -91,7 +93,8 @@ rule decisions_uav:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         cfg=canonical(DEC["uav"]),
         seed=config["seed"],
-        code=code_digest("workflow/scripts/decisions_uav.py"),
+        families=DEC_UAV_FAMILIES,
+        code=code_digest("workflow/scripts/decisions_uav.py", DEC_UAV_FAMILIES),
     script:
         "../scripts/decisions_uav.py"
 
@@ -126,7 +129,8 @@ rule decisions_map_cell:
         ),
         scoring=DEC_SCORING,
         seed=config["seed"],
-        code=code_digest("workflow/scripts/decisions_map_cell.py"),
+        families=DEC_MAP_FAMILIES,
+        code=code_digest("workflow/scripts/decisions_map_cell.py", DEC_MAP_FAMILIES),
     script:
         "../scripts/decisions_map_cell.py"
 

@@ -3,13 +3,14 @@
 # (one thread: the time is the study's measure of compute), then aggregation and the figure.
 import json
 
-from rsmhp.figures.frontier import CONFIRM_FIGURES
-from rsmhp.figures.frontier import FIGURES as FRONTIER_FIGURES
-from rsmhp.narrative.frontier import CONFIRM_TABLES
-from rsmhp.narrative.frontier import TABLES as FRONTIER_TABLES
-from rsmhp.protocol import confirm_plan
+from rsmhp.studies.frontier.figures import CONFIRM_FIGURES
+from rsmhp.studies.frontier.figures import FIGURES as FRONTIER_FIGURES
+from rsmhp.studies.frontier.section import CONFIRM_TABLES
+from rsmhp.studies.frontier.section import TABLES as FRONTIER_TABLES
+from rsmhp.pipeline.protocol import confirm_plan
 
 FRONTIER = config["decisions"]["frontier"]
+FRONTIER_FAMILIES = families_of(FRONTIER["methods"], "decisions.frontier.methods")
 FRONTIER_MODELS = list(FRONTIER["models"])
 FRONTIER_REC = config["decisions"]["recording"]
 FRONTIER_RECORDING = f"results/recordings/dec_{FRONTIER_REC['model']}_planners.rrd"
@@ -60,7 +61,8 @@ rule decisions_frontier:
         ),
         scoring=DEC_SCORING,
         seed=config["seed"],
-        code=code_digest("workflow/scripts/decisions_frontier.py"),
+        families=FRONTIER_FAMILIES,
+        code=code_digest("workflow/scripts/decisions_frontier.py", FRONTIER_FAMILIES),
     script:
         "../scripts/decisions_frontier.py"
 
@@ -87,7 +89,10 @@ rule decisions_frontier_timing:
         models=canonical(config["decisions"]["uav"]["models"]),
         cfg=pick(FRONTIER, "methods", "timing"),
         seed=config["seed"],
-        code=code_digest("workflow/scripts/decisions_frontier_timing.py"),
+        families=FRONTIER_FAMILIES,
+        code=code_digest(
+            "workflow/scripts/decisions_frontier_timing.py", FRONTIER_FAMILIES
+        ),
     script:
         "../scripts/decisions_frontier_timing.py"
 
@@ -170,7 +175,10 @@ rule decisions_frontier_recording:
         cfg=canonical(FRONTIER),
         recording=canonical(FRONTIER_REC),
         seed=config["seed"],
-        code=code_digest("workflow/scripts/decisions_frontier_recording.py"),
+        families=FRONTIER_FAMILIES,
+        code=code_digest(
+            "workflow/scripts/decisions_frontier_recording.py", FRONTIER_FAMILIES
+        ),
     script:
         "../scripts/decisions_frontier_recording.py"
 
@@ -186,7 +194,7 @@ rule frontier_exploratory:
 # ---------------------------------------------------------------------------- the protocol
 # Tuning (target `tune`, `make tune`; not part of the default run): every candidate of
 # decisions.frontier.tuning in closed loop and in an interleaved timing on the tuning stream,
-# then the selection rule (rsmhp.protocol.select) writes results/tune/tuned.yaml.
+# then the selection rule (rsmhp.pipeline.protocol.select) writes results/tune/tuned.yaml.
 TUNING = FRONTIER["tuning"]
 
 
@@ -211,7 +219,8 @@ rule frontier_tune:
         tuning=canonical(TUNING),
         track_loss_error=FRONTIER["track_loss_error"],
         seed=config["seed"],
-        code=code_digest("workflow/scripts/frontier_tune.py"),
+        families=FRONTIER_FAMILIES,
+        code=code_digest("workflow/scripts/frontier_tune.py", FRONTIER_FAMILIES),
     script:
         "../scripts/frontier_tune.py"
 
@@ -237,7 +246,8 @@ rule frontier_tune_timing:
         models=canonical(config["decisions"]["uav"]["models"]),
         tuning=canonical(TUNING),
         seed=config["seed"],
-        code=code_digest("workflow/scripts/frontier_tune_timing.py"),
+        families=FRONTIER_FAMILIES,
+        code=code_digest("workflow/scripts/frontier_tune_timing.py", FRONTIER_FAMILIES),
     script:
         "../scripts/frontier_tune_timing.py"
 
@@ -312,7 +322,8 @@ rule frontier_confirm:
         stream=CONFIRM["stream"] if CONFIRM is not None else None,
         track_loss_error=FRONTIER["track_loss_error"],
         seed=config["seed"],
-        code=code_digest("workflow/scripts/frontier_confirm.py"),
+        families=FRONTIER_FAMILIES,
+        code=code_digest("workflow/scripts/frontier_confirm.py", FRONTIER_FAMILIES),
     script:
         "../scripts/frontier_confirm.py"
 
@@ -340,7 +351,10 @@ rule frontier_confirm_timing:
         stream=CONFIRM["stream"] if CONFIRM is not None else None,
         timing=canonical(FRONTIER["confirm"]["timing"]),
         seed=config["seed"],
-        code=code_digest("workflow/scripts/frontier_confirm_timing.py"),
+        families=FRONTIER_FAMILIES,
+        code=code_digest(
+            "workflow/scripts/frontier_confirm_timing.py", FRONTIER_FAMILIES
+        ),
     script:
         "../scripts/frontier_confirm_timing.py"
 

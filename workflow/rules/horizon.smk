@@ -3,16 +3,17 @@
 # (one thread), paired closed-loop runs per (model, H); the oven LQG (horizon.lqg): cost
 # estimators and decision regret at long horizons against exact oracles; then aggregation,
 # claims and report section, and the figures.
-from rsmhp.figures.horizon import FIGURES as HORIZON_FIGURES
-from rsmhp.figures.optimiser_split import FIGURES as OPTIMISER_FIGURES
-from rsmhp.narrative.horizon import TABLES as HORIZON_TABLES
-from rsmhp.narrative.optimiser_split import TABLES as OPTIMISER_TABLES
-from rsmhp.protocol import stream_seed
+from rsmhp.studies.horizon.figures import FIGURES as HORIZON_FIGURES
+from rsmhp.studies.horizon.figures_optimiser import FIGURES as OPTIMISER_FIGURES
+from rsmhp.studies.horizon.section import TABLES as HORIZON_TABLES
+from rsmhp.studies.horizon.section_optimiser import TABLES as OPTIMISER_TABLES
+from rsmhp.pipeline.protocol import stream_seed
 
 # the seed stream every job of the study draws from (horizon.stream: confirm, the stream of
 # the published verdicts; exploratory: the stream of the runs published up to 76a0c01)
 HZ_SEED = stream_seed(config["seed"], config["horizon"]["stream"])
 HZ = config["horizon"]["uav"]
+HZ_FAMILIES = families_of(HZ["methods"], "horizon.uav.methods")
 HZL = config["horizon"]["lqg"]
 HZL_MODEL = pick(config["lqg"]["model"], "x0", "r", "target", "sigma")
 HZ_MODELS = list(HZ["models"])
@@ -30,6 +31,7 @@ if HZ_MODELS:
 # variant and H (models: default horizon.uav.models), then the summary with its report
 # section (order 34, after the horizon section) and the figure.
 HZO = config["horizon"]["optimiser"]
+HZO_FAMILIES = families_of(HZO["methods"], "horizon.optimiser.methods")
 HZO_MODELS = list(HZ_MODELS if HZO.get("models") is None else HZO["models"])
 HZO_JOBS = [f"{m}_H{h}" for m in HZO_MODELS for h in HZO["H"]]
 # what one job of the split depends on besides the model, H and the planner
@@ -69,7 +71,8 @@ rule horizon_uav:
         cfg=pick(HZ, "runs", "steps", "plans", "n_ref", "replicates", "methods"),
         scoring=DEC_SCORING,
         seed=HZ_SEED,
-        code=code_digest("workflow/scripts/horizon_uav.py"),
+        families=HZ_FAMILIES,
+        code=code_digest("workflow/scripts/horizon_uav.py", HZ_FAMILIES),
     script:
         "../scripts/horizon_uav.py"
 
@@ -94,7 +97,8 @@ rule horizon_uav_closed:
         models=canonical(config["decisions"]["uav"]["models"]),
         cfg=pick(HZ, "closed_runs", "methods"),
         seed=HZ_SEED,
-        code=code_digest("workflow/scripts/horizon_uav_closed.py"),
+        families=HZ_FAMILIES,
+        code=code_digest("workflow/scripts/horizon_uav_closed.py", HZ_FAMILIES),
     script:
         "../scripts/horizon_uav_closed.py"
 
@@ -234,7 +238,8 @@ rule horizon_recording:
         cfg=pick(HZ, "closed_runs", "methods", "claims"),
         recording=canonical(HZ_REC),
         seed=HZ_SEED,
-        code=code_digest("workflow/scripts/horizon_recording.py"),
+        families=HZ_FAMILIES,
+        code=code_digest("workflow/scripts/horizon_recording.py", HZ_FAMILIES),
     script:
         "../scripts/horizon_recording.py"
 
@@ -260,7 +265,8 @@ rule horizon_optimiser:
         cfg=pick(HZO, *HZO_KEYS),
         scoring=pick(DEC["uav"], "n_eval", "polish", "random_starts"),
         seed=HZ_SEED,
-        code=code_digest("workflow/scripts/horizon_optimiser.py"),
+        families=HZO_FAMILIES,
+        code=code_digest("workflow/scripts/horizon_optimiser.py", HZO_FAMILIES),
     script:
         "../scripts/horizon_optimiser.py"
 

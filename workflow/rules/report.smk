@@ -3,10 +3,10 @@
 # `make publish` copies them to paper/ and README.md (tracked); a replication never touches
 # tracked files. `make verify` (rule verify) compares claims.json with paper/claims.json.
 
-# Across scenarios (rsmhp.analysis.scenarios): every method's probability of beating NBO run
+# Across scenarios (rsmhp.studies.scenarios.summarise): every method's probability of beating NBO run
 # by run over the map cells and the long-horizon closed loop (descriptive, no claim).
-from rsmhp.figures.scenarios import FIGURES as SCENARIO_FIGURES
-from rsmhp.narrative.scenarios import TABLES as SCENARIO_TABLES
+from rsmhp.studies.scenarios.figures import FIGURES as SCENARIO_FIGURES
+from rsmhp.studies.scenarios.section import TABLES as SCENARIO_TABLES
 
 SCN_MAP = expand("results/decisions/map/{cell}.csv", cell=MAP_CELLS)
 SCN_CLOSED = expand("results/horizon/uav/{job}_closed.csv", job=HZ_JOBS)

@@ -5,11 +5,12 @@
 # and recordings as separate rules.
 import re
 
-from rsmhp.experiments.uav import UAV_MODEL_KEYS, chunk_runs
-from rsmhp.uav import methods as uav_methods
+from rsmhp.studies.uav.simulate import UAV_MODEL_KEYS, chunk_runs
+from rsmhp.models.uav import methods as uav_methods
 
 UAV = config["uav"]
 UAV_SPECS = uav_methods.from_config(UAV["methods"], "uav.methods")
+UAV_FAMILIES = families_of(UAV_SPECS.values())
 UAV_METHODS = list(UAV_SPECS)
 UAV_CHUNKS = list(range(min(UAV["chunks"], UAV["runs"])))
 UAV_RECORDED = list(range(min(UAV["recording"]["runs"], UAV["runs"])))
@@ -54,7 +55,10 @@ rule uav_simulate:
         method=lambda wc: UAV_SPECS[wc.method].spec(),
         runs=lambda wc: chunk_runs(UAV["runs"], len(UAV_CHUNKS), int(wc.chunk)),
         seed=config["seed"],
-        code=code_digest("workflow/scripts/uav_simulate.py"),
+        families=lambda wc: families_of([UAV_SPECS[wc.method]]),
+        code=lambda wc: code_digest(
+            "workflow/scripts/uav_simulate.py", families_of([UAV_SPECS[wc.method]])
+        ),
     script:
         "../scripts/uav_simulate.py"
 
@@ -174,7 +178,8 @@ rule uav_recording:
         methods=[s.spec() for s in UAV_SPECS.values()],
         max_hypotheses=UAV["recording"]["max_hypotheses"],
         seed=config["seed"],
-        code=code_digest("workflow/scripts/uav_recording.py"),
+        families=UAV_FAMILIES,
+        code=code_digest("workflow/scripts/uav_recording.py", UAV_FAMILIES),
     script:
         "../scripts/uav_recording.py"
 

@@ -2,14 +2,14 @@
 
 from pathlib import Path
 
-from rsmhp.analysis.decisions_lqg import LQG_SUMMARY_COLUMNS
-from rsmhp.analysis.decisions_uav import MAP_COLUMNS
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.decisions_uav import regret_contract
-from rsmhp.figures import decisions as figs
-from rsmhp.figures import save_figure
-from rsmhp.io import read_table
-from rsmhp.pipeline import rule_logging
+from rsmhp.models.lqg.regret_summary import LQG_SUMMARY_COLUMNS
+from rsmhp.models.uav.scoring import regret_contract
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import read_table
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.figures import save_figure
+from rsmhp.studies.decisions import figures as figs
+from rsmhp.studies.decisions.summarise_uav import MAP_COLUMNS
 
 with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent

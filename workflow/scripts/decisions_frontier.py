@@ -1,9 +1,9 @@
 """Rule decisions_frontier: the equal-compute study of one model variant (closed and open
 loop, planning time per step)."""
 
-from rsmhp.experiments.frontier import run_frontier_model
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.simulate import run_frontier_model
 
 with rule_logging(snakemake):
     p = snakemake.params

@@ -2,11 +2,11 @@
 
 from pathlib import Path
 
-from rsmhp.analysis.frontier import FRONTIER_SUMMARY_COLUMNS
-from rsmhp.figures import save_figure
-from rsmhp.figures.frontier import frontier_figure
-from rsmhp.io import read_table
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import read_table
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.figures import save_figure
+from rsmhp.studies.frontier.figures import frontier_figure
+from rsmhp.studies.frontier.summarise import FRONTIER_SUMMARY_COLUMNS
 
 with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent

@@ -2,14 +2,14 @@
 every family's budget member side by side, in the run chosen by decisions.recording.select
 from the frontier's paired differences (Monte-Carlo budget member − NBO)."""
 
-from rsmhp.analysis.frontier import select_run
-from rsmhp.claims.frontier import budget_member
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.frontier import frontier_contracts, recording_setup
-from rsmhp.pipeline import rule_logging
-from rsmhp.uav.methods import baseline
-from rsmhp.uav.methods.monte_carlo import MonteCarlo
-from rsmhp.uav.recording import record_checked_run
+from rsmhp.models.uav.methods import baseline
+from rsmhp.models.uav.methods.monte_carlo import MonteCarlo
+from rsmhp.models.uav.recording import record_checked_run
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.claims import budget_member
+from rsmhp.studies.frontier.simulate import frontier_contracts, recording_setup
+from rsmhp.studies.frontier.summarise import select_run
 
 with rule_logging(snakemake) as log:
     p = snakemake.params

@@ -6,12 +6,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.analysis.frontier import summarize_frontier
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.frontier import frontier_contracts, timing_contract
-from rsmhp.io import write_csv, write_text
-from rsmhp.narrative.frontier import frontier_section, frontier_tables
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import write_csv, write_text
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.section import frontier_section, frontier_tables
+from rsmhp.studies.frontier.simulate import frontier_contracts, timing_contract
+from rsmhp.studies.frontier.summarise import summarize_frontier
 
 with rule_logging(snakemake) as log:
     p = snakemake.params

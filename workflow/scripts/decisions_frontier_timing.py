@@ -1,9 +1,9 @@
 """Rule decisions_frontier_timing: interleaved wall-clock timing of every method's plan call
 on one model variant of the equal-compute study."""
 
-from rsmhp.experiments.frontier import time_planners
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.simulate import time_planners
 
 with rule_logging(snakemake):
     p = snakemake.params

@@ -1,8 +1,8 @@
 """Rule decisions_lqg: regret of each method's argmin on the scalar LQG."""
 
-from rsmhp.experiments.decisions_lqg import run_lqg_regret
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.models.lqg.regret import run_lqg_regret
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
 
 with rule_logging(snakemake):
     df = run_lqg_regret(

@@ -2,12 +2,12 @@
 
 from pathlib import Path
 
-from rsmhp.analysis import decisions_lqg as analysis
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.decisions_lqg import regret_contract
-from rsmhp.io import write_csv, write_text
-from rsmhp.narrative import decisions_lqg as narrative
-from rsmhp.pipeline import rule_logging
+from rsmhp.models.lqg import regret_summary as analysis
+from rsmhp.models.lqg.regret import regret_contract
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import write_csv, write_text
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.decisions import section_lqg as narrative
 
 with rule_logging(snakemake):
     model = snakemake.params.model

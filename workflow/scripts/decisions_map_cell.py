@@ -1,8 +1,8 @@
 """Rule decisions_map_cell: paired closed-loop runs and open-loop regret of one map cell."""
 
-from rsmhp.experiments.decisions_uav import run_map_cell
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.models.uav.scoring import run_map_cell
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
 
 with rule_logging(snakemake):
     runs, regret = run_map_cell(

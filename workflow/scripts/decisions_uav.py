@@ -1,8 +1,8 @@
 """Rule decisions_uav: open-loop regret of every method's plan at belief states."""
 
-from rsmhp.experiments.decisions_uav import run_uav_regret
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.models.uav.scoring import run_uav_regret
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
 
 with rule_logging(snakemake):
     df = run_uav_regret(

@@ -4,12 +4,12 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.analysis import decisions_uav as analysis
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.decisions_uav import map_contracts, regret_contract
-from rsmhp.io import write_csv, write_text
-from rsmhp.narrative import decisions_uav as narrative
-from rsmhp.pipeline import rule_logging
+from rsmhp.models.uav.scoring import map_contracts, regret_contract
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import write_csv, write_text
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.decisions import section_uav as narrative
+from rsmhp.studies.decisions import summarise_uav as analysis
 
 with rule_logging(snakemake):
     cfg, seed = snakemake.params.cfg, snakemake.params.seed

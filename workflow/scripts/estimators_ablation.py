@@ -1,8 +1,8 @@
 """Rule estimators_ablation: every scheme x weighting x size, seeded per cell and replicate."""
 
-from rsmhp.experiments.estimators import run_ablation
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.models.lqg.ablation import run_ablation
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
 
 with rule_logging(snakemake):
     df = run_ablation(

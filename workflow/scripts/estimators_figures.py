@@ -2,10 +2,10 @@
 
 from pathlib import Path
 
-from rsmhp.analysis.estimators import SUMMARY_COLUMNS, problems_from_config
-from rsmhp.figures import estimators as figs
-from rsmhp.io import read_table
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import read_table
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.estimators import figures as figs
+from rsmhp.studies.estimators.summarise import SUMMARY_COLUMNS, problems_from_config
 
 with rule_logging(snakemake):
     s = read_table(snakemake.input.summary, SUMMARY_COLUMNS)

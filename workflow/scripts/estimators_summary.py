@@ -2,12 +2,12 @@
 
 from pathlib import Path
 
-from rsmhp.analysis import estimators as analysis
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.estimators import ablation_contract
-from rsmhp.io import write_csv, write_text
-from rsmhp.narrative import estimators as narrative
-from rsmhp.pipeline import rule_logging
+from rsmhp.models.lqg.ablation import ablation_contract
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import write_csv, write_text
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.estimators import section as narrative
+from rsmhp.studies.estimators import summarise as analysis
 
 with rule_logging(snakemake):
     ks = list(snakemake.params.ks)

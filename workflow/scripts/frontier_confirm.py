@@ -1,10 +1,10 @@
 """Rule frontier_confirm: closed-loop runs of the preregistered configurations on one model
 variant, on the confirmatory stream."""
 
-from rsmhp.experiments.frontier import run_configurations
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
-from rsmhp.protocol import Configuration, stream_seed
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.protocol import Configuration, stream_seed
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.simulate import run_configurations
 
 with rule_logging(snakemake):
     p = snakemake.params

@@ -5,14 +5,14 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.analysis.frontier import ladder, summarize_configs
-from rsmhp.claims.frontier import confirm_claims
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.frontier import config_runs_contract, config_timing_contract
-from rsmhp.io import write_csv, write_text
-from rsmhp.narrative.frontier import confirm_section, confirm_tables
-from rsmhp.pipeline import rule_logging
-from rsmhp.protocol import Configuration, file_commit, tuned_configurations
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import write_csv, write_text
+from rsmhp.pipeline.protocol import Configuration, file_commit, tuned_configurations
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.claims import confirm_claims
+from rsmhp.studies.frontier.section import confirm_section, confirm_tables
+from rsmhp.studies.frontier.simulate import config_runs_contract, config_timing_contract
+from rsmhp.studies.frontier.summarise import ladder, summarize_configs
 
 with rule_logging(snakemake) as log:
     c = snakemake.params.confirm

@@ -1,10 +1,10 @@
 """Rule frontier_confirm_timing: interleaved wall-clock timing of the preregistered
 configurations on one model variant, at belief states of the confirmatory stream."""
 
-from rsmhp.experiments.frontier import time_configurations
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
-from rsmhp.protocol import Configuration, stream_seed
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.protocol import Configuration, stream_seed
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.simulate import time_configurations
 
 with rule_logging(snakemake):
     p = snakemake.params

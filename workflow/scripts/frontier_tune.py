@@ -1,10 +1,10 @@
 """Rule frontier_tune: closed-loop runs of every tuning candidate (and NBO) on one model
 variant, on the tuning stream."""
 
-from rsmhp.experiments.frontier import run_configurations
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
-from rsmhp.protocol import stream_seed, tuning_configurations
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.protocol import stream_seed, tuning_configurations
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.simulate import run_configurations
 
 with rule_logging(snakemake):
     p = snakemake.params

@@ -1,16 +1,16 @@
-"""Rule frontier_tune_select: the tuning rule (rsmhp.protocol.select) over every model, the
+"""Rule frontier_tune_select: the tuning rule (rsmhp.pipeline.protocol.select) over every model, the
 tuned file with its provenance, the selection table and its Markdown."""
 
 import pandas as pd
 import yaml
 
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.frontier import config_runs_contract, config_timing_contract
-from rsmhp.io import write_csv, write_text
-from rsmhp.markdown import markdown_table
-from rsmhp.pipeline import rule_logging
-from rsmhp.protocol import select, stream_seed, tuned_document, tuning_configurations
-from rsmhp.provenance import provenance
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import write_csv, write_text
+from rsmhp.pipeline.protocol import select, stream_seed, tuned_document, tuning_configurations
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.markdown import markdown_table
+from rsmhp.report.provenance import provenance
+from rsmhp.studies.frontier.simulate import config_runs_contract, config_timing_contract
 
 with rule_logging(snakemake) as log:
     p = snakemake.params

@@ -1,10 +1,10 @@
 """Rule frontier_tune_timing: interleaved wall-clock timing of every tuning candidate (and
 NBO) on one model variant, at belief states of the tuning stream."""
 
-from rsmhp.experiments.frontier import time_configurations
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
-from rsmhp.protocol import stream_seed, tuning_configurations
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.protocol import stream_seed, tuning_configurations
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.simulate import time_configurations
 
 with rule_logging(snakemake):
     p = snakemake.params

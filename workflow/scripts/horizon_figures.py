@@ -2,22 +2,22 @@
 
 from pathlib import Path
 
-from rsmhp.analysis.decisions_lqg import LQG_SUMMARY_COLUMNS
-from rsmhp.analysis.horizon import (
-    APPROX_SUMMARY_COLUMNS,
-    CLOSED_SUMMARY_COLUMNS,
-    REGRET_SUMMARY_COLUMNS,
-)
-from rsmhp.analysis.horizon_lqg import LQG_ESTIMATOR_COLUMNS
-from rsmhp.figures import save_figure
-from rsmhp.figures.horizon import (
+from rsmhp.models.lqg.regret_summary import LQG_SUMMARY_COLUMNS
+from rsmhp.pipeline.io import read_table
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.figures import save_figure
+from rsmhp.studies.horizon.figures import (
     horizon_closed_figure,
     horizon_error_figure,
     horizon_lqg_figure,
     horizon_time_figure,
 )
-from rsmhp.io import read_table
-from rsmhp.pipeline import rule_logging
+from rsmhp.studies.horizon.summarise_lqg import LQG_ESTIMATOR_COLUMNS
+from rsmhp.studies.horizon.summarise_uav import (
+    APPROX_SUMMARY_COLUMNS,
+    CLOSED_SUMMARY_COLUMNS,
+    REGRET_SUMMARY_COLUMNS,
+)
 
 with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent

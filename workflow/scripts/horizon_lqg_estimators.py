@@ -1,8 +1,8 @@
 """Rule horizon_lqg_estimators: the oven LQG's cost estimators at long horizons (exact J)."""
 
-from rsmhp.experiments.horizon_lqg import run_lqg_estimators
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.horizon.simulate_lqg import run_lqg_estimators
 
 with rule_logging(snakemake):
     p = snakemake.params

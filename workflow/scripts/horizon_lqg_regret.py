@@ -1,8 +1,8 @@
 """Rule horizon_lqg_regret: the oven LQG's decision regret at long horizons (exact argmins)."""
 
-from rsmhp.experiments.horizon_lqg import run_lqg_regret
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.horizon.simulate_lqg import run_lqg_regret
 
 with rule_logging(snakemake):
     p = snakemake.params

@@ -1,8 +1,8 @@
 """Rule horizon_optimiser: the optimiser split of one model variant and horizon."""
 
-from rsmhp.experiments.optimiser_split import run_optimiser_split
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.horizon.simulate_optimiser import run_optimiser_split
 
 with rule_logging(snakemake):
     p, w = snakemake.params, snakemake.wildcards

@@ -2,11 +2,11 @@
 
 from pathlib import Path
 
-from rsmhp.figures import save_figure
-from rsmhp.figures.optimiser_split import optimiser_figure
-from rsmhp.io import read_table
-from rsmhp.narrative.optimiser_split import SUMMARY_COLUMNS
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import read_table
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.figures import save_figure
+from rsmhp.studies.horizon.figures_optimiser import optimiser_figure
+from rsmhp.studies.horizon.section_optimiser import SUMMARY_COLUMNS
 
 with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent

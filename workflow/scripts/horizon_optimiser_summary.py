@@ -5,15 +5,15 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.optimiser_split import split_contract
-from rsmhp.io import write_csv, write_text
-from rsmhp.narrative.optimiser_split import (
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import write_csv, write_text
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.horizon.section_optimiser import (
     optimiser_section,
     optimiser_summary,
     optimiser_tables,
 )
-from rsmhp.pipeline import rule_logging
+from rsmhp.studies.horizon.simulate_optimiser import split_contract
 
 with rule_logging(snakemake) as log:
     p = snakemake.params

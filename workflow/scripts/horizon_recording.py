@@ -3,12 +3,12 @@ planning step with the hypotheses' predicted tracks and the plan (rerun recordin
 chosen by horizon.uav.recording.select from the closed-loop runs' paired differences
 (claims.monte_carlo − NBO) at that horizon."""
 
-from rsmhp.analysis.frontier import select_run
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.horizon import closed_contract, horizon_setup, recording_members
-from rsmhp.pipeline import rule_logging
-from rsmhp.uav.methods import baseline
-from rsmhp.uav.recording import record_checked_run
+from rsmhp.models.uav.methods import baseline
+from rsmhp.models.uav.recording import record_checked_run
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.frontier.summarise import select_run
+from rsmhp.studies.horizon.simulate_uav import closed_contract, horizon_setup, recording_members
 
 with rule_logging(snakemake) as log:
     p = snakemake.params

@@ -5,23 +5,23 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.analysis.horizon import (
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import read_table, write_csv, write_text
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.horizon.section import horizon_section, horizon_tables
+from rsmhp.studies.horizon.section_optimiser import SUMMARY_COLUMNS as OPTIMISER_COLUMNS
+from rsmhp.studies.horizon.simulate_lqg import estimator_contract, regret_contract
+from rsmhp.studies.horizon.simulate_uav import closed_contract, horizon_contracts
+from rsmhp.studies.horizon.summarise_lqg import (
+    summarize_lqg_estimators,
+    summarize_lqg_horizon_regret,
+)
+from rsmhp.studies.horizon.summarise_uav import (
     lqg_horizon_table,
     summarize_approx,
     summarize_closed,
     summarize_horizon_regret,
 )
-from rsmhp.analysis.horizon_lqg import (
-    summarize_lqg_estimators,
-    summarize_lqg_horizon_regret,
-)
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.horizon import closed_contract, horizon_contracts
-from rsmhp.experiments.horizon_lqg import estimator_contract, regret_contract
-from rsmhp.io import read_table, write_csv, write_text
-from rsmhp.narrative.horizon import horizon_section, horizon_tables
-from rsmhp.narrative.optimiser_split import SUMMARY_COLUMNS as OPTIMISER_COLUMNS
-from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake) as log:
     p = snakemake.params

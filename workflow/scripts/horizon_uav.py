@@ -1,8 +1,8 @@
 """Rule horizon_uav: one model variant and horizon of the UAV horizon study."""
 
-from rsmhp.experiments.horizon import run_horizon
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.horizon.simulate_uav import run_horizon
 
 with rule_logging(snakemake):
     p, w = snakemake.params, snakemake.wildcards

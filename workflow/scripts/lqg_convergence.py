@@ -1,8 +1,8 @@
 """Rule lqg_convergence: MHP estimates vs P (paper Fig. 3) -> results/lqg/convergence.csv."""
 
-from rsmhp.experiments.lqg import run_convergence
-from rsmhp.io import write_csv
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import write_csv
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.lqg.simulate import run_convergence
 
 with rule_logging(snakemake):
     df = run_convergence(snakemake.params.lqg, snakemake.params.seed, n_jobs=snakemake.threads)

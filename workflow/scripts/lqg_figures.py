@@ -3,13 +3,13 @@ error with residuals (PNG + PDF)."""
 
 from pathlib import Path
 
-from rsmhp.analysis.lqg import eps_label
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.lqg import convergence_contract
-from rsmhp.figures import lqg as figs
-from rsmhp.figures import save_figure
-from rsmhp.io import read_table
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import read_table
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.figures import save_figure
+from rsmhp.studies.lqg import figures as figs
+from rsmhp.studies.lqg.simulate import convergence_contract
+from rsmhp.studies.lqg.summarise import eps_label
 
 with rule_logging(snakemake):
     eps = list(snakemake.params.eps)

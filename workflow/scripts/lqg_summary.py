@@ -2,16 +2,16 @@
 
 from pathlib import Path
 
-from rsmhp.analysis import lqg as analysis
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.lqg import (
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import write_csv, write_text
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.lqg import section as narrative
+from rsmhp.studies.lqg import summarise as analysis
+from rsmhp.studies.lqg.simulate import (
     convergence_contract,
     linear_cost_contract,
     nbo_error_contract,
 )
-from rsmhp.io import write_csv, write_text
-from rsmhp.narrative import lqg as narrative
-from rsmhp.pipeline import rule_logging
 
 with rule_logging(snakemake):
     eps = list(snakemake.params.eps)

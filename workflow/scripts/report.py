@@ -6,14 +6,14 @@ import json
 import shutil
 from pathlib import Path
 
-from rsmhp.claims.paper import judge_all
-from rsmhp.io import write_text
-from rsmhp.ledger import Section, claims_records
-from rsmhp.pipeline import rule_logging
-from rsmhp.protocol import file_commit
-from rsmhp.provenance import code_provenance, provenance
-from rsmhp.report import glance_table, render_appendix, render_report, statements_records
-from rsmhp.verdicts import holm_sections
+from rsmhp.pipeline.io import write_text
+from rsmhp.pipeline.protocol import file_commit
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.ledger import Section, claims_records
+from rsmhp.report.provenance import code_provenance, provenance
+from rsmhp.report.render import glance_table, render_appendix, render_report, statements_records
+from rsmhp.report.statements import judge_all
+from rsmhp.report.verdicts import holm_sections
 
 with rule_logging(snakemake) as log:
     # Holm's correction over the benchmark's own comparisons (FR and HZ claims) before any

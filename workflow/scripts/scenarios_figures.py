@@ -3,11 +3,11 @@
 
 from pathlib import Path
 
-from rsmhp.analysis.scenarios import SUMMARY_COLUMNS
-from rsmhp.figures import save_figure
-from rsmhp.figures.scenarios import improvement_figure
-from rsmhp.io import read_table
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import read_table
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.figures import save_figure
+from rsmhp.studies.scenarios.figures import improvement_figure
+from rsmhp.studies.scenarios.summarise import SUMMARY_COLUMNS
 
 with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent

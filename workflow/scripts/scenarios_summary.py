@@ -5,10 +5,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.analysis.scenarios import improvement_summary, per_scenario, scenario_runs
-from rsmhp.io import read_table, write_csv, write_text
-from rsmhp.narrative.scenarios import scenarios_section, scenarios_tables
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import read_table, write_csv, write_text
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.scenarios.section import scenarios_section, scenarios_tables
+from rsmhp.studies.scenarios.summarise import improvement_summary, per_scenario, scenario_runs
 
 MAP_COLUMNS = ["cell", "row_value", "col_value", "method", "run", "mean_error"]
 CLOSED_COLUMNS = ["model", "H", "method", "run", "mean_error"]

@@ -1,8 +1,8 @@
 """Rules lqg_recording, estimators_recording: one LQG tree, step by step, as a rerun recording."""
 
-from rsmhp.lqg import LQGModel
-from rsmhp.pipeline import rule_logging
-from rsmhp.recording import record_lqg_tree
+from rsmhp.models.lqg.oven import LQGModel
+from rsmhp.models.lqg.recording import record_lqg_tree
+from rsmhp.pipeline.script import rule_logging
 
 with rule_logging(snakemake) as log:
     rec = snakemake.params.recording

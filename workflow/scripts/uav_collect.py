@@ -5,10 +5,10 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.contracts import check_table, read_checked
-from rsmhp.experiments.uav import STEP_COLUMNS, chunk_contracts, chunk_runs, runs_contract
-from rsmhp.io import write_csv, write_parquet
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.contracts import check_table, read_checked
+from rsmhp.pipeline.io import write_csv, write_parquet
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.uav.simulate import STEP_COLUMNS, chunk_contracts, chunk_runs, runs_contract
 
 with rule_logging(snakemake) as log:
     p = snakemake.params

@@ -3,13 +3,13 @@ error) and, for each, the paired view (per-run differences, mean and CI) (PNG + 
 
 from pathlib import Path
 
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.uav import runs_contract
-from rsmhp.figures import save_figure
-from rsmhp.figures import uav as figs
-from rsmhp.io import read_table
-from rsmhp.narrative.uav import FIGURES
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import read_table
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.figures import save_figure
+from rsmhp.studies.uav import figures as figs
+from rsmhp.studies.uav.section import FIGURES
+from rsmhp.studies.uav.simulate import runs_contract
 
 with rule_logging(snakemake):
     p = snakemake.params

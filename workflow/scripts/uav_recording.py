@@ -1,9 +1,9 @@
 """Rule uav_recording: run k with every method side by side, as a rerun recording."""
 
-from rsmhp.pipeline import rule_logging
-from rsmhp.uav import methods
-from rsmhp.uav.recording import record_uav_run
-from rsmhp.uav.simulation import UAVSetup
+from rsmhp.models.uav import methods
+from rsmhp.models.uav.recording import record_uav_run
+from rsmhp.models.uav.simulation import UAVSetup
+from rsmhp.pipeline.script import rule_logging
 
 with rule_logging(snakemake) as log:
     rows, _ = record_uav_run(

@@ -1,8 +1,8 @@
 """Rule uav_simulate: one method, one chunk of Monte-Carlo runs -> runs CSV + steps Parquet."""
 
-from rsmhp.experiments.uav import run_chunk
-from rsmhp.io import write_csv, write_parquet
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.io import write_csv, write_parquet
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.uav.simulate import run_chunk
 
 with rule_logging(snakemake):
     runs, steps = run_chunk(

@@ -2,12 +2,12 @@
 
 from pathlib import Path
 
-from rsmhp.analysis import uav as analysis
-from rsmhp.contracts import read_checked
-from rsmhp.experiments.uav import runs_contract
-from rsmhp.io import write_csv, write_text
-from rsmhp.narrative import uav as narrative
-from rsmhp.pipeline import rule_logging
+from rsmhp.pipeline.contracts import read_checked
+from rsmhp.pipeline.io import write_csv, write_text
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.uav import section as narrative
+from rsmhp.studies.uav import summarise as analysis
+from rsmhp.studies.uav.simulate import runs_contract
 
 with rule_logging(snakemake):
     an, seed = snakemake.params.analysis, snakemake.params.seed

@@ -2,8 +2,8 @@
 
 from pathlib import Path
 
-from rsmhp.pipeline import rule_logging
-from rsmhp.verify import VerificationError, verify
+from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.verify import VerificationError, verify
 
 with rule_logging(snakemake) as log:
     try:

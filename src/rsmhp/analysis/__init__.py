@@ -1,1 +1,0 @@
-"""Aggregation of raw experiment tables into summaries, Markdown tables and report sections."""

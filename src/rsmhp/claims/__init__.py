@@ -1,1 +1,0 @@
-"""Claims of each study: key numbers and verdict rules evaluated on the study's statistics."""

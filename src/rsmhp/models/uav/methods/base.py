@@ -1,0 +1,211 @@
+r"""The contract of a UAV planning method (one family per module of this package).
+
+A *family* (NBO, Monte Carlo, pruned tree, ...) is a subclass of :class:`Method` decorated
+with :func:`rsmhp.models.uav.methods.register`; an instance is one configured member (``RS-MHP
+N_T=250``). The class declares everything the pipeline needs, so that simulation, decision
+study, sensitivity map, palette, config checks and analysis iterate over the registry and never
+name a family:
+
+==================  ==========================================================================
+``family``          identifier written in the ``family`` column of every table
+``config_key``      its key in a ``methods`` block of the config (``uav.methods``,
+                    ``decisions.uav.methods``, ``decisions.map.methods``)
+``schema``          JSON Schema of that key's value (inserted into the config schema's
+                    ``$defs/uav_methods``; written once, here)
+``default``         the value when a ``methods`` block omits the key
+``family_label``    human-readable family name
+``colour_key``      the key of its colour in :data:`rsmhp.report.palette.METHOD_COLOURS`
+                    (presentation lives in the palette: a colour edit reruns no simulation)
+``order``           position of the family in tables and figures (smaller first)
+``baseline``        True for the one family every comparison is made against (NBO)
+``estimates_cost``  False for a family that has no cost estimate of an arbitrary plan (a
+                    tree search plans over simulated beliefs, not over hypotheses)
+==================  ==========================================================================
+
+and per instance: :meth:`Method.name` (rule wildcard, table key), :meth:`Method.columns` (the
+``N_T``, ``N``, ``M`` columns), :meth:`Method.job_key` (its part of the random-stream key:
+changing it changes every draw), :meth:`Method.label`, :meth:`Method.shade_size`,
+:meth:`Method.hypotheses` (the weighted hypotheses it plans over) and :meth:`Method.planner`
+(a :class:`rsmhp.models.uav.planner.Planner`; by default the method's hypotheses and L-BFGS-B).
+
+Hypotheses
+----------
+:class:`Hypotheses` are ``T`` future target trajectories ``states`` (T, H, 4) with weights
+:math:`\omega_i \ge 0`, :math:`\sum_i \omega_i = 1` (T,), and optionally the draws that made
+them, ``noise`` (T, H + 1, 4): ``noise[:, 0]`` the initial-state deviation
+:math:`x_0 - \hat x`, ``noise[:, j]`` the process noise :math:`w_j`. The planner's cost is
+:math:`J(u) = \sum_i \omega_i \sum_{j=1}^H \mathrm{tr}\,P^i_j(u)`.
+"""
+
+from __future__ import annotations
+
+import re
+from abc import ABC, abstractmethod
+from collections.abc import Mapping
+from dataclasses import InitVar, asdict, dataclass, fields
+from typing import Any, ClassVar
+
+import numpy as np
+
+from rsmhp.models.uav import target
+from rsmhp.models.uav.planner import Belief, Planner, SampledCostPlanner
+
+__all__ = ["COLUMNS", "Hypotheses", "Method", "from_design"]
+
+#: the method columns of every UAV table: trajectories averaged, draws per level, kept
+COLUMNS = ("N_T", "N", "M")
+
+
+@dataclass(frozen=True)
+class Hypotheses:
+    """Weighted target hypotheses of one planning step (see the module docstring)."""
+
+    states: np.ndarray
+    weights: np.ndarray
+    noise: np.ndarray | None = None
+    #: ``False`` skips the shape and weight checks: for a generator whose output is valid by
+    #: construction (NBO's single nominal hypothesis, planned at every closed-loop step)
+    check: InitVar[bool] = True
+
+    def __post_init__(self, check: bool) -> None:
+        if not check:
+            return
+        s = np.asarray(self.states, dtype=float)
+        if s.ndim != 3 or s.shape[0] == 0 or s.shape[2] != 4:
+            raise ValueError(f"Hypotheses.states must have shape (T, H, 4), got {s.shape}")
+        w = np.asarray(self.weights, dtype=float)
+        if w.shape != (s.shape[0],):
+            raise ValueError(f"Hypotheses.weights must have shape ({s.shape[0]},), got {w.shape}")
+        if not np.isfinite(w).all() or (w < 0).any() or abs(w.sum() - 1.0) > 1e-9:
+            raise ValueError(
+                f"Hypotheses.weights must be finite, >= 0 and sum to 1, got sum {w.sum()!r}"
+            )
+        if self.noise is not None:
+            n = np.asarray(self.noise, dtype=float)
+            if n.shape != (s.shape[0], s.shape[1] + 1, 4):
+                raise ValueError(
+                    f"Hypotheses.noise must have shape (T, H + 1, 4) = "
+                    f"({s.shape[0]}, {s.shape[1] + 1}, 4), got {n.shape}"
+                )
+
+    @classmethod
+    def equal(cls, states: np.ndarray, noise: np.ndarray | None = None) -> Hypotheses:
+        """``states`` with equal weights 1/T."""
+        n = np.shape(states)[0]
+        return cls(states, np.full(n, 1.0 / n), noise)
+
+    @property
+    def n(self) -> int:
+        return int(np.shape(self.states)[0])
+
+
+#: the identity square root: a design of :mod:`rsmhp.core.designs` given it draws standard normals
+_STANDARD = np.eye(4)
+_STANDARD.flags.writeable = False
+
+
+def from_design(belief: Belief, setup: Any, design, *args: Any) -> Hypotheses:
+    """Hypotheses of a point set of :mod:`rsmhp.core.designs`: ``design(*args, H + 1, I_4)``
+    gives standard-normal coordinates ``z`` (n, H + 1, 4) and weights, mapped to the initial
+    deviation and the H process noises by :func:`rsmhp.models.uav.target.from_normals`. Unchecked
+    (valid by construction), like every generator the closed loop calls."""
+    z, weights = design(*args, setup.planner.horizon + 1, _STANDARD)
+    states, noise = target.from_normals(belief.x_hat, belief.P_hat, z, setup.target, check=False)
+    return Hypotheses(states, weights, noise, check=False)
+
+
+@dataclass(frozen=True)
+class Method(ABC):
+    """One configured planning method; subclasses are families (see the module docstring)."""
+
+    family: ClassVar[str]
+    config_key: ClassVar[str]
+    schema: ClassVar[dict[str, Any]]
+    default: ClassVar[Any]
+    family_label: ClassVar[str]
+    colour_key: ClassVar[str]
+    order: ClassVar[int]
+    baseline: ClassVar[bool] = False
+    #: whether the planner draws random numbers; ``False`` (a deterministic method such as
+    #: NBO) spares the closed loop building the step's stream, and the planner gets ``None``
+    uses_rng: ClassVar[bool] = True
+    #: whether :meth:`hypotheses` gives the cost estimate of any plan (False: a tree search)
+    estimates_cost: ClassVar[bool] = True
+
+    # ---------------------------------------------------------------- construction
+    @classmethod
+    @abstractmethod
+    def from_config(cls, value: Any, path: str) -> list[Method]:
+        """The family's members from its config value (``path`` names the key in messages)."""
+
+    @classmethod
+    def config_problems(cls, value: Any, path: str, uav: Mapping[str, Any]) -> list[str]:
+        """Cross-field problems of the family's config value given the ``uav`` section (e.g.
+        more trajectories kept than a tree has leaves), as messages naming ``path``."""
+        return []
+
+    @classmethod
+    def parse(cls, name: str) -> Method | None:
+        """The member named ``name`` (:meth:`name`), or ``None`` if the name is not of this
+        family. Default: names matching ``name_pattern`` with its groups as the fields."""
+        m = re.fullmatch(cls.name_pattern, name)
+        if m is None:
+            return None
+        return cls(*(int(g) for g in m.groups()))
+
+    name_pattern: ClassVar[str]
+
+    # ---------------------------------------------------------------- identity
+    @property
+    @abstractmethod
+    def name(self) -> str:
+        """Unique name: the rule wildcard and the ``method`` column of every table."""
+
+    #: N_T, the number of hypotheses the cost averages over (a field or a property)
+    n_traj: ClassVar[int]
+
+    def columns(self) -> dict[str, int]:
+        """The :data:`COLUMNS` of this method's table rows (0 where a field does not apply)."""
+        return {"N_T": self.n_traj, "N": 0, "M": 0}
+
+    def job_key(self) -> dict[str, Any]:
+        """The method's part of its random-stream keys (``rsmhp.core.seeding.job_rng``)."""
+        return {"method": self.name, "N_T": self.n_traj, "N": None, "M": None}
+
+    def spec(self) -> dict[str, Any]:
+        """JSON-ready description (rule params; :func:`rsmhp.models.uav.methods.from_spec`)."""
+        return {"family": self.family, **asdict(self)}
+
+    def label(self) -> str:
+        """Human-readable name (figures and tables)."""
+        return self.family_label
+
+    def shade_size(self) -> int | None:
+        """The size (hypotheses) that shades this member's colour in the palette
+        (:func:`rsmhp.report.palette.method_colour`); ``None``: the family's colour."""
+        return None
+
+    def sort_key(self) -> tuple:
+        """Position in tables and figures: family order, then the columns."""
+        c = self.columns()
+        return (self.order, c["N_T"], c["N"], c["M"], self.name)
+
+    # ---------------------------------------------------------------- planning
+    @abstractmethod
+    def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator) -> Hypotheses:
+        """The weighted hypotheses this method plans over at ``belief`` (horizon
+        ``setup.planner.horizon``; ``setup`` a :class:`rsmhp.models.uav.simulation.UAVSetup`),
+        drawn from ``rng``. Unchecked: the closed loop checks its inputs once per run."""
+
+    def planner(self, setup: Any) -> Planner:
+        """The planner of this method for ``setup``: by default its hypotheses, the weighted
+        covariance cost and L-BFGS-B (:class:`rsmhp.models.uav.planner.SampledCostPlanner`)."""
+
+        def draw(belief: Belief, rng: np.random.Generator) -> Hypotheses:
+            return self.hypotheses(belief, setup, rng)
+
+        return SampledCostPlanner(draw, setup.uav, setup.target, setup.sensor, setup.planner)
+
+    @classmethod
+    def field_names(cls) -> tuple[str, ...]:
+        return tuple(f.name for f in fields(cls))

@@ -1,0 +1,73 @@
+r"""RS-MHP with non-overlapping trajectories (plain Monte Carlo): ``N_T`` independent futures,
+:math:`x_0^i \sim \mathcal N(\hat x, \hat P)`, :math:`x_j^i = F x_{j-1}^i + w_j^i`, each of
+weight :math:`1/N_T` (:func:`rsmhp.models.uav.target.draw_independent`). Config: ``rsmhp_nt: [50,
+100, 250]``, one method per N_T, named ``rsmhp_nt<N_T>``."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any, ClassVar
+
+import numpy as np
+
+from rsmhp.core import guards
+from rsmhp.models.uav import target
+from rsmhp.models.uav.methods import register
+from rsmhp.models.uav.methods.base import Hypotheses, Method
+from rsmhp.models.uav.planner import Belief
+
+__all__ = ["MonteCarlo"]
+
+
+@register
+@dataclass(frozen=True)
+class MonteCarlo(Method):
+    """RS-MHP with ``n_traj`` = N_T independent hypotheses."""
+
+    n_traj: int
+
+    family: ClassVar[str] = "rsmhp"
+    config_key: ClassVar[str] = "rsmhp_nt"
+    schema: ClassVar[dict[str, Any]] = {
+        "description": "N_T values of non-overlapping RS-MHP (independent hypotheses).",
+        "type": "array",
+        "maxItems": 20,
+        "uniqueItems": True,
+        "items": {"type": "integer", "minimum": 1, "maximum": 100000},
+    }
+    default: ClassVar[Any] = []
+    family_label: ClassVar[str] = "RS-MHP"
+    colour_key: ClassVar[str] = "rsmhp"
+    order: ClassVar[int] = 1
+    name_pattern: ClassVar[str] = r"rsmhp_nt(\d+)"
+
+    def __post_init__(self) -> None:
+        # whole-number floats become ints (1.0 and 1 already name the same random streams)
+        object.__setattr__(self, "n_traj", guards.positive_int("n_traj (N_T)", self.n_traj))
+
+    @classmethod
+    def from_config(cls, value: Any, path: str) -> list[Method]:
+        guards.instance_of(path, value, (list, tuple))
+        return [cls(guards.positive_int(f"{path}[{i}]", n)) for i, n in enumerate(value)]
+
+    @property
+    def name(self) -> str:
+        return f"rsmhp_nt{self.n_traj}"
+
+    def label(self) -> str:
+        return f"RS-MHP N_T={self.n_traj}"
+
+    def shade_size(self) -> int:
+        return self.n_traj
+
+    def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator) -> Hypotheses:
+        states, noise = target.draw_independent(
+            belief.x_hat,
+            belief.P_hat,
+            setup.planner.horizon,
+            self.n_traj,
+            setup.target,
+            rng,
+            check=False,
+        )
+        return Hypotheses.equal(states, noise)

@@ -1,0 +1,1 @@
+"""The lqg study."""
