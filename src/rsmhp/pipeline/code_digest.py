@@ -20,14 +20,17 @@ package, unless the caller names the modules of that package the job can reach (
 rule that runs some UAV planning methods passes their family modules, so its digest covers the
 method registry, its base and those families, and adding or editing another family's module
 leaves it alone (the rule also passes them as its ``families`` param, with which the job checks
-its code when it starts). The script and each module are hashed in a normalised form, their syntax tree
-without positions (a stable rendering of :mod:`ast` that omits empty fields, so it does not
+its code when it starts). The script and each module are hashed in a normalised form, their syntax
+tree without positions (a stable rendering of :mod:`ast` that omits empty fields, so it does not
 depend on the Python version's node layout): an edit that changes only comments, blank
 lines, line breaks, quotes or other formatting keeps the digest; any change of code or of a
 docstring changes it. The digest is the first 12 hex digits of a SHA-256 over the sorted
-(module, module digest) pairs; it does not depend on where the checkout lives. Not covered:
-third-party packages (``results/provenance.json`` records their versions), data files the
-code reads, and modules reached only through a string the analysis cannot see.
+(module, module digest) pairs; it does not depend on where the checkout lives. Report templates
+count as code: every ``*.md`` file in the directory of a covered module (a study's section
+templates, :mod:`rsmhp.report.templates`) is hashed byte for byte under the name
+``<package>/<file>``. Not covered: third-party packages (``results/provenance.json`` records
+their versions), other data files the code reads, and modules reached only through a string
+the analysis cannot see.
 
 Why params and not the source files as rule inputs: Snakemake compares inputs by
 modification time, so ``touch``, a ``git checkout`` of another branch and back, or a fresh
@@ -325,6 +328,12 @@ def describe(
             todo.extend(only[package] if package in only else _package_modules(package, src))
     if disk is not None:
         disk.save()
+    for name in [n for n in digests if n != script.name]:
+        found = _locate(name, src)
+        if found is not None:
+            package = name if found[1] else name.rpartition(".")[0]
+            for template in sorted(found[0].parent.glob("*.md")):
+                digests[f"{package}/{template.name}"] = _hex(template.read_bytes())
     modules = dict(sorted(digests.items()))
     text = "".join(f"{k} {v}\n" for k, v in modules.items())
     return CodeDigest(script.name, _hex(text.encode())[:DIGEST_LENGTH], modules)
