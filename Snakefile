@@ -63,6 +63,7 @@ include: "workflow/rules/uav.smk"
 include: "workflow/rules/decisions.smk"
 include: "workflow/rules/frontier.smk"
 include: "workflow/rules/horizon.smk"
+include: "workflow/rules/scenarios.smk"
 include: "workflow/rules/report.smk"
 
 

@@ -4,66 +4,55 @@ Reference implementation and replication pipeline for Ragi & Mittelmann, "Random
 Monte-Carlo Tree Search Methods for Cost Approximation in Long-Horizon Optimal Control",
 IEEE Control Systems Letters 5(5), 2021.
 
-Sub-modules
------------
-Core (model-independent)
-  seeding           stable, order-independent random streams (SeedSequence keyed on job ids)
-  sampling          tree / pruned-tree / non-overlapping trajectory sampling with likeliness
-  designs           fixed-budget noise designs: MC, antithetic, Sobol', cubature, Gauss-Hermite
-  cost_estimators   uniform and likeliness-weighted averages, NBO
-  boxqn             compiled projected L-BFGS over [-1, 1]^n (scipy's budgets and tolerances)
-  linear_quadratic  linear-Gaussian systems with quadratic cost and their exact oracles
-  stats             confidence intervals (mean, RMSE, binomial; cluster-t and bootstrap-t
-                    over few clusters), log-log slope fits, Holm's correction, t-test power
-  guards            argument checks of the public entry points (ValueError / TypeError naming
-                    the argument, the value and what is allowed)
-Models
-  lqg               the scalar "oven" LQG case study and all its closed forms
-  lqg_horizon       the oven LQG at long horizons: limits in H, the horizon at which the
-                    optimal first control stops depending on H (closed forms)
-  uav               UAV target tracking: kinematics, target, sensor, tracker (filterpy, the
-                    reference), stepper (compiled closed-loop step: aircraft, target,
-                    tracker), kernel (numpy oracle), fused (compiled weighted cost + exact
-                    gradient, vectorised over hypotheses; the compiled planning step),
-                    planner (Planner and Optimiser protocols: boxqn, scipy's L-BFGS-B),
-                    methods (registry of planning methods, one module per family),
-                    dpw (compiled tree search with double progressive widening),
-                    simulation, recording
-Stages of the pipeline (one module per model and stage)
-  experiments       lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon,
-                    horizon_lqg, optimiser_split: config -> tidy tables
-  analysis          lqg, estimators, uav, decisions_lqg, decisions_uav, frontier, horizon,
-                    horizon_lqg, optimiser_split: tables -> statistics; scenarios: every
-                    method's probability of beating NBO across map cells and horizons
-  protocol          the comparison protocol: seed streams (exploratory, tune, confirm,
-                    confirm2), planner configurations, the tuning rule, the preregistration
-  figures           lqg, estimators, uav, decisions, frontier, horizon, optimiser_split,
-                    scenarios: seaborn figures (PNG + PDF)
-  recording         rerun recordings of sampled trajectory trees
-  claims            per study: the claims (key number + verdict rule) from the statistics;
-                    claims.paper: the paper's statements, each with its evidence and verdict
-  narrative         per study: the report section's prose, tables and appendix (Markdown)
-  ledger            the claims data model: KeyNumber, Claim, Section
-  verdicts          verdict rules as objects (Rule, Case, at_most, ci_side, non_inferior):
-                    text + evaluation
-  markdown          number formatting and Markdown tables
-  provenance        commit, config hash, package versions, BLAS and CPU of a run
-  report            renders the main text, appendix, claims and glance table from the sections
-  readme            splices the glance table into README.md (``make publish``)
-  verify            a run's claims against the committed reference (``make verify``)
-  portability       the portability drill: a run on an emulated other machine against the
-                    native run and the reference (``make portability``)
-  palette           one colour and label per method, for every figure and recording
-Workflow support
-  config            config files and schema checks (``python -m rsmhp.pipeline.config FILE``)
-  resources         memory estimate of each simulation rule from the config
-  contracts         what each intermediate file must hold, checked before aggregation
-  io                atomic, umask-honouring writers and checked readers
-  parallel          joblib fan-out that honours a thread budget without oversubscribing BLAS
-  pipeline          logging of rule scripts
-  code_digest       content digest of the package code each rule imports (reruns never stale)
-  cluster           SLURM pre-flight: every job fits a node of its partition (sinfo)
-  numba_cache       drops numba's cache of a module when a module it inlines changed
+The package is layered: ``core`` below ``models``, ``pipeline`` and ``report`` beside them, and
+one package per study on top. A study builds on the layers below and never on another study;
+inside a study, ``simulate`` never imports its ``claims``, ``section`` or ``figures``
+(tests/pipeline/test_layout.py checks both on the import graph).
+
+Sub-packages
+------------
+  core              model-independent: seeding (stable, order-independent random streams),
+                    sampling (tree / pruned-tree / non-overlapping trajectories, likeliness),
+                    designs (fixed-budget noise designs: MC, antithetic, Sobol', cubature,
+                    Gauss-Hermite), cost_estimators (uniform and likeliness-weighted averages,
+                    NBO), boxqn (compiled projected L-BFGS over [-1, 1]^n), stats (intervals,
+                    paired differences, slopes, Holm, t-test power, probability of
+                    improvement), guards (argument checks), numba_cache (drops a compiled
+                    module's cache when a module it inlines changed)
+  models            the case studies' models. models.lqg: oven (the scalar oven LQG and its
+                    closed forms), linear_quadratic (linear-Gaussian problems with quadratic
+                    cost and their exact oracles), horizon (long-horizon limits), ablation
+                    (the estimator ablation and its per-cell summary), regret and
+                    regret_summary (open-loop regret), recording (rerun trees).
+                    models.uav: kinematics, target, sensor, tracker (filterpy, the reference),
+                    stepper (compiled closed-loop step), kernel (numpy oracle), fused (compiled
+                    weighted cost + exact gradient), planner (Planner and Optimiser
+                    protocols), methods (registry, one module per planning family), dpw
+                    (compiled tree search), simulation, scoring (open-loop scoring of belief
+                    states, shared by the studies), recording
+  pipeline          workflow support: config (config files and schema checks, ``python -m
+                    rsmhp.pipeline.config FILE``), contracts (what each intermediate holds),
+                    io (atomic writers, checked readers), code_digest (the code each rule
+                    depends on, per method family where a rule runs some), parallel (joblib
+                    within a thread budget), resources (memory estimates), cluster (SLURM
+                    pre-flight), protocol (seed streams, planner configurations, tuning rule,
+                    preregistration), script (logging and code checks of rule scripts)
+  report            ledger (KeyNumber, Claim, Section), verdicts (verdict rules as objects),
+                    statements (the paper's statements and their evidence), render (main text,
+                    appendix, claims, glance table), templates (Jinja2 section templates),
+                    markdown (number formatting, tables), palette (one colour and label per
+                    method), figures (theme, save_figure), provenance, readme (``make
+                    publish``), verify (``make verify``), portability (``make portability``)
+  studies           one package per study, each with simulate (config -> tidy tables),
+                    summarise (tables -> statistics), claims (key numbers and verdicts),
+                    figures, section (the report section, prose in Markdown templates):
+                    lqg (Fig. 3), estimators (the estimator ablation), uav (Figs. 4-5),
+                    decisions (LQG and UAV regret, the sensitivity map), frontier (equal
+                    compute: exploratory frontier, tuning, confirmatory run), horizon (long
+                    horizons, LQG and UAV, and the optimiser split), scenarios (the
+                    probability of beating NBO across scenarios)
+  testing           check_method: the conformance check of a planning-method family (run it
+                    first on a new one)
 """
 
 __version__ = "0.1.0"

@@ -416,3 +416,20 @@ def test_one_sided_and_tost_edge_cases_and_refusals():
         tost_p_value(0.0, 1.0, 5, 0.0)
     with pytest.raises(TypeError, match="estimate"):
         tost_p_value(None, 1.0, 5, 1.0)
+
+
+def test_mean_bootstrap_ci_is_the_mean_interval_and_nan_below_two_values():
+    """The paired comparisons' one interval: bootstrap_ci of the mean on the same stream, and
+    (nan, nan) without touching the stream when fewer than 2 values pair."""
+    from rsmhp.core.stats import bootstrap_ci, mean_bootstrap_ci
+
+    x = np.random.default_rng(3).normal(size=40)
+    assert mean_bootstrap_ci(x, np.random.default_rng(7), 500) == bootstrap_ci(
+        x, np.random.default_rng(7), 500, 0.95
+    )
+    rng = np.random.default_rng(7)
+    state = rng.bit_generator.state
+    assert all(np.isnan(v) for v in mean_bootstrap_ci(np.array([1.0]), rng, 500))
+    assert rng.bit_generator.state == state
+    lo, hi = mean_bootstrap_ci(x, np.random.default_rng(7), 2000, 0.95)
+    assert lo < x.mean() < hi

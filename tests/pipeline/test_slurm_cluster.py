@@ -1,5 +1,5 @@
 """The workflow on a real single-node SLURM cluster (scripts/slurm-local.sh), through the
-profile workflow/profiles/slurm, with the commands of the README's "Run on a cluster".
+profile workflow/profiles/slurm, with the commands of docs/cluster.md.
 
 Marker ``slurm``: run on the project's machines (root on Debian; CI brings the cluster up from
 the distribution's packages), skipped with the reason elsewhere. Oracles: SLURM's own record
@@ -29,7 +29,7 @@ pytestmark = pytest.mark.slurm
 SCRIPT = ROOT / "scripts" / "slurm-local.sh"
 PROFILE = ROOT / "workflow" / "profiles" / "slurm"
 RECORDS = Path("/var/log/slurm/jobcomp.tsv")
-#: the README's command, with the node's CPU count as max-threads and quick status checks
+#: docs/cluster.md's command, with the node's CPU count as max-threads and quick status checks
 RUN = [
     sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--configfile", str(TINY),
     "--profile", str(PROFILE), "--max-threads", str(os.cpu_count() or 1),
@@ -95,7 +95,7 @@ SAME = [
 
 
 def test_workflow_runs_through_slurm_like_locally_and_survives_scancel(cluster, run_j2, tmp_path):
-    """The README's command on the tiny config's LQG and long-horizon targets: every job goes
+    """docs/cluster.md's command on the tiny config's LQG and long-horizon targets: every job goes
     through SLURM (its records), the tables equal the local run's, the CPUs and memory of each
     job are the rule's and the profile's; a running job cancelled with scancel is retried
     (`retries: 1`) and the run completes."""

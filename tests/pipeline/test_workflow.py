@@ -278,7 +278,8 @@ def test_invalid_config_fails_before_any_job(run_j2, tmp_path, override, field):
 
 
 def test_nested_command_line_override_is_applied(run_j2):
-    """README's override syntax: a nested YAML value after --config, typed like the file."""
+    """docs/workflow.md's override syntax: a nested YAML value after --config, typed like the
+    file."""
     res = snakemake(run_j2, "-n", "--config", "lqg={model: {a: 0.3}}")
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-2000:]
@@ -551,7 +552,7 @@ def test_uav_decision_outputs(run_j2, tiny):
 
 
 def test_killed_run_resumes_to_identical_results(run_j2, tmp_path):
-    """README's recovery recipe: SIGKILL mid-run (jobs in flight), --unlock, then
+    """docs/workflow.md's recovery recipe: SIGKILL mid-run (jobs in flight), --unlock, then
     --rerun-incomplete gives the same data as the uninterrupted run."""
     import os
     import signal
@@ -753,18 +754,18 @@ def test_code_edits_rerun_exactly_the_rules_that_import_the_code(run_j2, tmp_pat
         return scheduled, params, importers
 
     # (a) a model module: the simulations that import it and what is made from them
-    scheduled, params, _ = edit("uav/kinematics.py")
+    scheduled, params, _ = edit("models/uav/kinematics.py")
     assert {"uav_simulate", "decisions_uav", "decisions_map_cell"} <= params
     assert {"uav_collect", "uav_summary", "report"} <= scheduled
     lqg_side = {r for r in users if r.startswith(("lqg_", "estimators_", "decisions_lqg"))}
     assert {"lqg_convergence", "lqg_figures", "estimators_figures"} <= lqg_side
     assert not lqg_side & scheduled, lqg_side & scheduled  # the UAV code is not theirs
     # (b) an analysis module: aggregation (and what uses it) only, no simulation
-    scheduled, params, _ = edit("analysis/lqg.py")
+    scheduled, params, _ = edit("studies/lqg/summarise.py")
     assert "lqg_summary" in params and "report" in scheduled
     assert not scheduled & SIMULATIONS and not any(r.endswith("recording") for r in scheduled)
     # (c) a figure module: figure rules only, and the report that copies the figures
-    scheduled, params, _ = edit("figures/uav.py")
+    scheduled, params, _ = edit("studies/uav/figures.py")
     assert "uav_figures" in params
     assert scheduled <= {r for r in users if r.endswith("_figures")} | {"report"}
     # comments, formatting and modification times alone rerun nothing
@@ -777,18 +778,21 @@ def test_code_edits_rerun_exactly_the_rules_that_import_the_code(run_j2, tmp_pat
 def test_provenance_records_the_code_of_every_rule(run_j2):
     """results/provenance.json: per rule the digest its outputs record, which the code now
     gives, and the modules behind it; every table a rule wrote records that rule."""
-    from rsmhp.pipeline.code_digest import describe
+    from rsmhp.pipeline.code_digest import describe, method_only, split_stamp_rule
     from rsmhp.pipeline.io import recorded_code
 
     code = json.loads((run_j2 / "results/provenance.json").read_text())["code"]
     rules = code["rules"]
-    assert SIMULATIONS | {"lqg_summary", "estimators_summary", "uav_collect", "report"} <= set(
-        rules
-    )
+    # a rule that runs UAV planning methods is recorded per set of families it runs
+    # ("uav_simulate+nbo"): its digest counts only those families' modules
+    names = {split_stamp_rule(r)[0] for r in rules}
+    assert SIMULATIONS | {"lqg_summary", "estimators_summary", "uav_collect", "report"} <= names
+    assert "uav_simulate+nbo" in rules and "uav_simulate" not in rules
     for rule, entry in rules.items():
         ((digest, files),) = entry["recorded"].items()  # one code version per rule
         assert entry["current"] == digest, rule
-        now = describe(ROOT / f"workflow/scripts/{rule}.py", ROOT / "src")
+        name, families = split_stamp_rule(rule)
+        now = describe(ROOT / f"workflow/scripts/{name}.py", ROOT / "src", method_only(families))
         assert digest == now.digest and entry["modules"] == list(now.modules), rule
         assert all(code["modules"][m] == d[:12] for m, d in now.modules.items())
         for f in files:

@@ -1,6 +1,7 @@
 """One colour per method (rsmhp.report.palette), shared by figures and recordings."""
 
 import ast
+import sys
 from pathlib import Path
 
 import pytest
@@ -49,14 +50,20 @@ def test_unknown_methods_are_refused_by_name():
 
 
 def test_uav_names_are_resolved_by_the_registry_the_palette_does_not_import(monkeypatch):
-    """The palette knows UAV methods only through a registered resolver (so the LQG figures
-    do not depend on the UAV code); without one, a UAV name is refused with the reason."""
+    """The palette never imports the UAV registry (so the LQG figures do not depend on the UAV
+    code) and the registry never imports the palette (so a colour edit reruns no simulation):
+    UAV names resolve through the registry once something imported it, or a registered
+    resolver; without either, a UAV name is refused with the reason."""
     tree = ast.parse(Path(palette.__file__).read_text())
     imported = [n.module for n in ast.walk(tree) if isinstance(n, ast.ImportFrom)]
     imported += [a.name for n in ast.walk(tree) if isinstance(n, ast.Import) for a in n.names]
     assert imported and not any(str(m).startswith("rsmhp") for m in imported), imported
+    registry = Path(rsmhp.models.uav.methods.__file__).read_text()
+    assert "palette" not in registry, "the method registry must not import the palette"
+    assert method_colour("rsmhp_nt250").startswith("#")  # the registry is imported: resolved
     monkeypatch.setattr(palette, "_RESOLVERS", [])
-    with pytest.raises(ValueError, match=r"import rsmhp\.uav\.methods"):
+    monkeypatch.delitem(sys.modules, "rsmhp.models.uav.methods")
+    with pytest.raises(ValueError, match=r"import rsmhp\.models\.uav\.methods"):
         method_colour("rsmhp_nt250")
     assert method_colour("nbo") == METHOD_COLOURS["nbo"]  # fixed schemes need no resolver
     palette.register_resolver(rsmhp.models.uav.methods.from_name)

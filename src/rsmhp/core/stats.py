@@ -4,7 +4,8 @@
 * :func:`binomial_ci` - Clopper-Pearson (exact) interval of a proportion.
 * :func:`loglog_slope` - OLS slope of log(y) on log(x) with a t-based confidence interval.
 * :func:`rmse_ci` - RMSE with a chi-square interval assuming the errors are N(0, s^2)-like.
-* :func:`bootstrap_ci` - percentile bootstrap interval of any statistic.
+* :func:`bootstrap_ci` - percentile bootstrap interval of any statistic;
+  :func:`mean_bootstrap_ci` - of a mean (paired differences), NaN below 2 values.
 * :func:`exceedance_test` - exceedance counts against the exact tail probability and a bound.
 * :func:`detectable_scale` - the spread error an exceedance test detects (its power).
 
@@ -44,6 +45,7 @@ __all__ = [
     "exceedance_test",
     "holm",
     "loglog_slope",
+    "mean_bootstrap_ci",
     "mean_ci",
     "one_sided_p_value",
     "paired_wins",
@@ -131,6 +133,19 @@ def bootstrap_ci(
     boots = stat(x[idx], axis=1)
     lo, hi = np.quantile(boots, [0.5 - level / 2, 0.5 + level / 2])
     return float(lo), float(hi)
+
+
+def mean_bootstrap_ci(
+    x: np.ndarray, rng: np.random.Generator, n_boot: int, level: float = 0.95
+) -> tuple[float, float]:
+    """Percentile-bootstrap CI of the mean of ``x`` (e.g. paired differences d = a − b, one
+    per pair), :func:`bootstrap_ci` with ``stat = mean``; ``(nan, nan)`` for fewer than 2
+    values (no resampling: ``rng`` is left untouched). The one definition the studies'
+    paired comparisons use (each passes a stream keyed on its comparison)."""
+    x = np.asarray(x, dtype=float)
+    if x.size < 2:
+        return float("nan"), float("nan")
+    return bootstrap_ci(x, rng, n_boot, level)
 
 
 #: relative spread errors the pipeline searches for the power of an exceedance test

@@ -103,11 +103,14 @@ def method_colour(method: str) -> str:
 
 
 def member_colour(member: Any) -> str:
-    """Hex colour of a UAV method ``member`` (an object with ``colour_key`` and
-    ``shade_size()``): its family's colour, shaded by size where it has one (RS-MHP members in
+    """Hex colour of a UAV method ``member`` (an object with ``colour_key``, a key of
+    :data:`METHOD_COLOURS` or, for a family this palette does not know such as a plugin's, a hex
+    colour itself, and ``shade_size()``): its family's colour, shaded by size where it has one
+    (RS-MHP members in
     :data:`RSMHP_SHADES` by N_T, split at 10, 50, 100, 250; other sized families by
     :func:`size_shade`)."""
-    base = METHOD_COLOURS[member.colour_key]
+    key = member.colour_key
+    base = key if str(key).startswith("#") else METHOD_COLOURS[key]
     size = member.shade_size()
     if size is None:
         return base

@@ -1,7 +1,7 @@
-"""The README's worked example of a new planning method, run end to end.
+"""The worked example of a new planning method in docs/methods.md, run end to end.
 
-The block between the README's ``example:method`` markers is executed here as it stands,
-registering a toy family (nominal future plus weighted samples); it then runs through a
+The block between the ``example:method`` markers of docs/methods.md is executed here as it
+stands, registering a toy family (nominal future plus weighted samples); it then runs through a
 closed-loop run, the open-loop scoring of the decision study, the per-method summary and the
 paired table, and the palette, without any other file knowing about it.
 """
@@ -33,16 +33,16 @@ CONFIG = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 
 @pytest.fixture(scope="module")
 def mix():
-    text = (ROOT / "README.md").read_text(encoding="utf-8")
+    text = (ROOT / "docs" / "methods.md").read_text(encoding="utf-8")
     block = re.search(
         r"<!-- example:method:begin -->\s*```python\n(.*?)```\s*<!-- example:method:end -->",
         text,
         re.S,
     )
-    assert block, "README: the example:method block is missing"
-    module = types.ModuleType("readme_nominal_mix")
+    assert block, "docs/methods.md: the example:method block is missing"
+    module = types.ModuleType("docs_nominal_mix")
     sys.modules[module.__name__] = module  # dataclasses look their module up
-    exec(compile(block.group(1), "README.md:example:method", "exec"), module.__dict__)
+    exec(compile(block.group(1), "docs/methods.md:example:method", "exec"), module.__dict__)
     yield module.NominalMix
     methods.unregister("mix")
     del sys.modules[module.__name__]

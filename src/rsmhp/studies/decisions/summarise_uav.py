@@ -32,7 +32,7 @@ import pandas as pd
 from scipy import stats as sps
 
 from rsmhp.core.seeding import job_rng
-from rsmhp.core.stats import bootstrap_ci
+from rsmhp.core.stats import mean_bootstrap_ci
 from rsmhp.models.uav import methods as registry
 from rsmhp.models.uav.methods import baseline_name, is_family
 from rsmhp.models.uav.methods.monte_carlo import MonteCarlo
@@ -147,10 +147,7 @@ def axis_value(key: str, value: Any) -> str:
 def _boot_mean(x: np.ndarray, seed: int, n_boot: int, **key: Any) -> tuple[float, float]:
     """Percentile-bootstrap 95% CI of the mean of ``x``, resampled from a stream keyed on
     ``key``; NaNs for fewer than 2 values."""
-    x = np.asarray(x, dtype=float)
-    if x.size < 2:
-        return float("nan"), float("nan")
-    return bootstrap_ci(x, job_rng(seed, "decisions_bootstrap", **key), n_boot, 0.95)
+    return mean_bootstrap_ci(x, job_rng(seed, "decisions_bootstrap", **key), n_boot)
 
 
 # ---------------------------------------------------------------------------- open-loop regret

@@ -39,7 +39,7 @@ import numpy as np
 import pandas as pd
 
 from rsmhp.core.seeding import job_rng
-from rsmhp.core.stats import ClusterInterval, bootstrap_ci, cluster_t_ci, paired_wins
+from rsmhp.core.stats import ClusterInterval, cluster_t_ci, mean_bootstrap_ci, paired_wins
 from rsmhp.models.uav import methods
 from rsmhp.pipeline.protocol import budget_cost
 
@@ -92,10 +92,7 @@ FRONTIER_SUMMARY_COLUMNS = [
 def _ci(x: np.ndarray, seed: int, n_boot: int, **key: Any) -> tuple[float, float]:
     """95% percentile-bootstrap CI of the mean of ``x`` (NaNs for fewer than 2 values): the
     interval of the exploratory tables up to 76a0c01, kept beside the cluster-t one."""
-    x = np.asarray(x, dtype=float)
-    if x.size < 2:
-        return float("nan"), float("nan")
-    return bootstrap_ci(x, job_rng(seed, "frontier_bootstrap", **key), n_boot, 0.95)
+    return mean_bootstrap_ci(x, job_rng(seed, "frontier_bootstrap", **key), n_boot)
 
 
 def cluster_mean_ci(x: np.ndarray, clusters: np.ndarray) -> ClusterInterval | None:

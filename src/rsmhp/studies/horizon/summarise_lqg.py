@@ -3,7 +3,7 @@ only: the claims HZ-4 and HZ-5 are in :mod:`rsmhp.studies.horizon.claims`, prose
 :mod:`rsmhp.studies.horizon.section`.
 
 Estimators: per cell (a, H, scheme, weighting, N, M, n) the estimator study's summary
-(:func:`rsmhp.studies.estimators.summarise.summarize_ablation`: bias, RMSE with percentile-bootstrap
+(:func:`rsmhp.models.lqg.ablation.summarize_ablation`: bias, RMSE with percentile-bootstrap
 CIs over replicates) divided by the exact cost J of the cell's problem: relative bias
 :math:`(\bar{\hat J} - J)/J` and relative RMSE :math:`\sqrt{\overline{(\hat J - J)^2}}/J`,
 and for uniform Monte Carlo its closed form :math:`\sqrt{\mathrm{Var}\,g / n}/J`
@@ -25,9 +25,8 @@ import pandas as pd
 
 from rsmhp.core.seeding import job_rng
 from rsmhp.models.lqg import horizon as lqg_horizon
-from rsmhp.models.lqg.ablation import build_problem
+from rsmhp.models.lqg.ablation import build_problem, summarize_ablation
 from rsmhp.models.lqg.regret_summary import ZERO_REGRET, summarize_lqg_regret
-from rsmhp.studies.estimators.summarise import summarize_ablation
 from rsmhp.studies.horizon.simulate_lqg import problem_name, problem_specs
 
 __all__ = [

@@ -14,7 +14,8 @@ name a family:
                     ``$defs/uav_methods``; written once, here)
 ``default``         the value when a ``methods`` block omits the key
 ``family_label``    human-readable family name
-``colour_key``      the key of its colour in :data:`rsmhp.report.palette.METHOD_COLOURS`
+``colour_key``      the key of its colour in :data:`rsmhp.report.palette.METHOD_COLOURS`, or a
+                    hex colour (``"#7a5195"``) for a family the palette does not know
                     (presentation lives in the palette: a colour edit reruns no simulation)
 ``order``           position of the family in tables and figures (smaller first)
 ``baseline``        True for the one family every comparison is made against (NBO)

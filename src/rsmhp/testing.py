@@ -1,0 +1,846 @@
+r"""Conformance check of a UAV planning-method family: :func:`check_method` (the analogue of
+scikit-learn's ``check_estimator``), the first thing to run on a new family.
+
+``check_method(cls)`` takes a registered :class:`rsmhp.models.uav.methods.Method` subclass
+and checks the contract of :mod:`rsmhp.models.uav.methods.base` on a few configured members,
+on a small setup (horizon :data:`HORIZON`, a short optimiser budget: seconds). It raises
+``AssertionError`` at the first failure, with a message naming the family, the member where
+there is one, and the failed property (the ``[...]`` tag below); it returns a
+:class:`CheckReport` otherwise.
+
+Members: those given (``members``), else ``cls.from_config(value)`` for the given ``value``,
+else for the family's optional ``example`` class attribute (a small config value), else for
+a small value derived from the family's ``schema`` (the two smallest of 4, 8, 16, 2, 1, ...
+that the schema and :meth:`~rsmhp.models.uav.methods.Method.from_config` accept; ``True`` for a
+flag; required object fields only), else for ``default``.
+
+Properties
+----------
+Class (``[class attributes]``, ``[schema]``, ``[default]``, ``[colour_key]``, ``[registry]``):
+``family``, ``config_key``, ``family_label`` non-empty strings without spaces (the label may
+have them); ``schema`` a valid JSON Schema (``check_schema``); ``default`` valid against it;
+``colour_key`` a key of :data:`rsmhp.report.palette.METHOD_COLOURS` or a hex colour
+``#rrggbb`` (a family the palette does not know); ``order`` an int;
+``baseline``, ``uses_rng``, ``estimates_cost`` bools; the class registered, and exactly one
+baseline family.
+
+Members (``[config]``, ``[names]``, ``[round trip]``, ``[spec]``, ``[columns]``,
+``[job_key]``, ``[presentation]``, ``[registry config]``): the config value is valid against
+the schema, has no cross-field problem and builds them through the family, and through the
+registry (among the other families' defaults), counted by ``methods.count``; names non-empty, of
+``[A-Za-z0-9_.-]`` (rule wildcards and file names), unique, claimed by no other registered
+family; ``from_name(m.name) == m`` and ``from_spec(m.spec()) == m`` (and hashable);
+``columns()`` exactly ``N_T``, ``N``, ``M``, integers :math:`\ge 0`; ``job_key()`` a
+JSON-serialisable mapping with ``job_key()["method"] == m.name``, none of the closed loop's
+own keys (``run``, ``step``, ``experiment``), distinct across members and usable by
+:func:`rsmhp.core.seeding.job_rng`; ``spec()`` JSON-serialisable with the family;
+``label()`` a non-empty string, ``shade_size()`` ``None`` or a positive int, the palette
+colours the member (:func:`rsmhp.report.palette.method_colour` by name equals
+:func:`~rsmhp.report.palette.member_colour`).
+
+Hypotheses, for a family with ``estimates_cost`` (``[hypotheses]``, ``[weights]``,
+``[determinism]``, ``[stream independence]``): drawn from the member's closed-loop stream
+``job_rng(seed, "uav_plan", run=0, step=1, **m.job_key())``, a
+:class:`~rsmhp.models.uav.methods.Hypotheses` with states (T, H, 4), T >= 1, finite; weights
+(T,) finite, :math:`\ge 0`, :math:`|\sum_i \omega_i - 1| \le 10^{-12}`; ``noise`` ``None``
+or (T, H + 1, 4) finite and reproducing the states (:math:`x_0 = \hat x + n_0`,
+:math:`x_j = F x_{j-1} + n_j`); the belief is not modified. Determinism: the same seed gives
+identical arrays, also from an equal fresh member; with ``uses_rng`` another seed gives other
+hypotheses, without it ``rng=None`` gives the same ones. Independence: the draws depend only
+on the member's own stream: not on numpy's or Python's global random state, nor on draws made
+in between by the other members (no state carried from call to call).
+
+Planning step (``[planner]``, ``[plan]``, ``[plan determinism]``): ``m.planner(setup)`` is a
+:class:`rsmhp.models.uav.planner.Planner`; ``plan(belief, zeros (H, 2), rng)`` (``rng=None``
+without ``uses_rng``) returns a :class:`~rsmhp.models.uav.planner.PlanResult` with controls
+(H, 2) finite and within :math:`\pm` ``uav.control_scale``; ``uav_path`` (H, 4) the
+kinematic rollout of those controls; a finite ``cost``; ``cost_warm`` a float; ``nit``,
+``n_kernel_calls`` ints :math:`\ge 0`; ``work`` (machine-independent compute of the step,
+model steps) an int :math:`> 0`; ``diagnostics`` a mapping of names to floats;
+``converged`` ``None`` or a bool; ``hypotheses`` ``None`` or valid hypotheses of horizon H
+(those of :meth:`~rsmhp.models.uav.methods.Method.hypotheses` for the same stream when the
+family keeps the default planner). The wall time of the step is measured
+(:attr:`CheckReport.plan_seconds`, what the closed loop sums into ``plan_seconds``). The
+same planner planning again with the same seed (and other global random state) gives the
+identical result; the belief and warm start are not modified.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import random
+import re
+import time
+from collections.abc import Iterable, Iterator, Mapping
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+from typing import Any
+
+import jsonschema
+import numpy as np
+
+from rsmhp.core.seeding import job_rng
+from rsmhp.models.uav import methods as registry
+from rsmhp.models.uav.kinematics import UAVParams, rollout
+from rsmhp.models.uav.methods import COLUMNS, Hypotheses, Method
+from rsmhp.models.uav.planner import Belief, Planner, PlannerParams, PlanResult
+from rsmhp.models.uav.sensor import SensorModel
+from rsmhp.models.uav.simulation import UAVSetup
+from rsmhp.models.uav.target import TargetModel
+from rsmhp.report import palette
+
+__all__ = ["HORIZON", "CheckReport", "check_method", "example_belief", "example_setup"]
+
+#: planning horizon of :func:`example_setup`
+HORIZON = 4
+#: root seed of the streams the check draws from
+SEED = 20240601
+#: tolerance of :math:`|\sum_i \omega_i - 1|`
+WEIGHT_TOL = 1e-12
+#: keys the closed loop adds to a member's job key (``job_rng(seed, "uav_plan", run=r,
+#: step=k, **job_key)``)
+_RESERVED_KEYS = ("run", "step", "experiment")
+_NAME = re.compile(r"[A-Za-z0-9_.\-]+")
+_TOKEN = re.compile(r"[A-Za-z0-9_]+")
+_HEX = re.compile(r"#[0-9a-fA-F]{6}")
+
+
+@dataclass(frozen=True)
+class CheckReport:
+    """What :func:`check_method` checked: the family, its members' names, the properties (in
+    the order checked) and the wall time (s) of each member's planning step."""
+
+    family: str
+    members: tuple[str, ...]
+    checks: tuple[str, ...]
+    plan_seconds: dict[str, float] = field(default_factory=dict)
+
+
+def example_setup(horizon: int = HORIZON) -> UAVSetup:
+    """A small UAV setup: the paper's aircraft, target and sensor (``config/config.yaml``),
+    horizon ``horizon``, an optimiser budget of 10 iterations and 20 evaluations."""
+    return UAVSetup(
+        uav=UAVParams(
+            dt=1.0,
+            g=9.81,
+            accel_max=3.0,
+            bank_max=math.radians(45.0),
+            speed_min=10.0,
+            speed_max=35.0,
+            altitude=100.0,
+        ),
+        target=TargetModel(dt=1.0, q=1.0),
+        sensor=SensorModel(0.05, 0.10, 100.0),
+        planner=PlannerParams(horizon=horizon, maxiter=10, maxfun=20),
+        P0=np.diag([50.0**2, 50.0**2, 5.0**2, 5.0**2]),
+        steps=5,
+        scenario={
+            "target_box": 200.0,
+            "target_speed_min": 5.0,
+            "target_speed_max": 12.0,
+            "uav_distance_min": 300.0,
+            "uav_distance_max": 600.0,
+            "uav_speed": 20.0,
+        },
+    )
+
+
+def example_belief() -> Belief:
+    """A belief 300 m from the UAV with a correlated (non-diagonal) covariance."""
+    P_hat = np.array(
+        [
+            [900.0, 120.0, 30.0, -4.0],
+            [120.0, 400.0, 5.0, 9.0],
+            [30.0, 5.0, 16.0, 1.0],
+            [-4.0, 9.0, 1.0, 9.0],
+        ]
+    )
+    return Belief(np.array([0.0, 0.0, 20.0, 0.0]), np.array([300.0, -50.0, 6.0, 2.0]), P_hat)
+
+
+# ------------------------------------------------------------------------- the checker
+
+
+class _Checker:
+    """Names every failure after the family (and member) and the property checked."""
+
+    def __init__(self, cls: type) -> None:
+        self.cls = cls
+        family = getattr(cls, "family", "?")
+        self.where = f"{getattr(cls, '__name__', cls)!r} (family {family!r})"
+        self.done: list[str] = []
+
+    def fail(self, prop: str, detail: str, member: Method | None = None) -> None:
+        where = self.where
+        if member is not None:
+            where += f", member {_safe_name(member)!r}"
+        raise AssertionError(f"check_method {where}: [{prop}] {detail}")
+
+    def that(self, ok: bool, prop: str, detail: str, member: Method | None = None) -> None:
+        if not ok:
+            self.fail(prop, detail, member)
+
+    @contextmanager
+    def step(self, prop: str, member: Method | None = None) -> Iterator[None]:
+        """Run a block; an exception other than an ``AssertionError`` of the check is a
+        failure of ``prop``."""
+        try:
+            yield
+        except AssertionError as e:
+            if str(e).startswith("check_method "):
+                raise
+            self.fail(prop, f"{type(e).__name__}: {e}", member)
+        except Exception as e:
+            self.fail(prop, f"raised {type(e).__name__}: {e}", member)
+        if prop not in self.done:
+            self.done.append(prop)
+
+
+def _safe_name(m: Any) -> str:
+    try:
+        return str(m.name)
+    except Exception:
+        return repr(m)
+
+
+def check_method(
+    cls: type[Method],
+    members: Iterable[Method] | None = None,
+    *,
+    value: Any = None,
+    setup: UAVSetup | None = None,
+    belief: Belief | None = None,
+) -> CheckReport:
+    """Check the family ``cls`` and its members against the method contract (module
+    docstring); ``AssertionError`` naming the family, the member and the property at the
+    first failure. ``members``: configured members of ``cls`` to check; otherwise built from
+    the config ``value`` (or the family's example, see the module docstring). ``setup`` and
+    ``belief`` default to :func:`example_setup` and :func:`example_belief`."""
+    c = _Checker(cls)
+    with c.step("class attributes"):
+        c.that(
+            isinstance(cls, type) and issubclass(cls, Method),
+            "class attributes",
+            f"expected a subclass of rsmhp.models.uav.methods.Method, got {cls!r}",
+        )
+    _check_class(c, cls)
+    setup = example_setup() if setup is None else setup
+    belief = example_belief() if belief is None else belief
+    built, value = _members(c, cls, members, value, setup)
+    _check_members(c, cls, built)
+    if value is not None:
+        _check_registry_config(c, cls, built, value)
+    seconds: dict[str, float] = {}
+    for m in built:
+        if cls.estimates_cost:
+            _check_hypotheses(c, m, built, setup, belief)
+        seconds[m.name] = _check_plan(c, m, setup, belief)
+    return CheckReport(cls.family, tuple(m.name for m in built), tuple(c.done), seconds)
+
+
+# ------------------------------------------------------------------------------ class
+
+
+def _check_class(c: _Checker, cls: type[Method]) -> None:
+    with c.step("class attributes"):
+        for attr in ("family", "config_key"):
+            v = getattr(cls, attr, None)
+            c.that(
+                isinstance(v, str) and _TOKEN.fullmatch(v) is not None,
+                "class attributes",
+                f"{attr} must be a non-empty string of [A-Za-z0-9_], got {v!r}",
+            )
+        label = getattr(cls, "family_label", None)
+        c.that(
+            isinstance(label, str) and label.strip() != "",
+            "class attributes",
+            f"family_label must be a non-empty string, got {label!r}",
+        )
+        order = getattr(cls, "order", None)
+        c.that(
+            isinstance(order, int) and not isinstance(order, bool),
+            "class attributes",
+            f"order must be an int, got {order!r}",
+        )
+        for attr in ("baseline", "uses_rng", "estimates_cost"):
+            v = getattr(cls, attr, None)
+            c.that(isinstance(v, bool), "class attributes", f"{attr} must be a bool, got {v!r}")
+        pattern = getattr(cls, "name_pattern", None)
+        if pattern is not None:
+            c.that(
+                isinstance(pattern, str),
+                "class attributes",
+                f"name_pattern must be a str, got {pattern!r}",
+            )
+            re.compile(pattern)
+        for attr in ("schema", "default"):
+            c.that(hasattr(cls, attr), "class attributes", f"{attr} is missing")
+    with c.step("schema"):
+        schema = cls.schema
+        c.that(
+            isinstance(schema, Mapping),
+            "schema",
+            f"must be a mapping (a JSON Schema), got {type(schema).__name__}",
+        )
+        try:
+            _validator(schema).check_schema(schema)
+        except jsonschema.SchemaError as e:
+            c.fail("schema", f"not a valid JSON Schema: {e.message}")
+        json.dumps(schema)
+    with c.step("default"):
+        errors = list(_validator(cls.schema)(cls.schema).iter_errors(cls.default))
+        c.that(
+            not errors,
+            "default",
+            f"{cls.default!r} is not valid against the schema: "
+            + "; ".join(e.message for e in errors),
+        )
+    with c.step("colour_key"):
+        key = getattr(cls, "colour_key", None)
+        c.that(
+            isinstance(key, str) and (key in palette.METHOD_COLOURS or _HEX.fullmatch(key)),
+            "colour_key",
+            f"{key!r} is neither a key of rsmhp.report.palette.METHOD_COLOURS "
+            f"(allowed: {sorted(palette.METHOD_COLOURS)}) nor a hex colour '#rrggbb'",
+        )
+    with c.step("registry"):
+        fams = registry.families()
+        c.that(
+            cls in fams,
+            "registry",
+            "the class is not registered (decorate it with rsmhp.models.uav.methods.register)",
+        )
+        base = [f.family for f in fams if f.baseline]
+        c.that(
+            len(base) == 1,
+            "registry",
+            f"exactly one registered family must be the baseline, found {base}",
+        )
+
+
+def _validator(schema: Mapping[str, Any]) -> type:
+    return jsonschema.validators.validator_for(schema, default=jsonschema.Draft202012Validator)
+
+
+# ---------------------------------------------------------------------------- members
+
+
+def _members(
+    c: _Checker, cls: type[Method], members: Iterable[Method] | None, value: Any, setup: UAVSetup
+) -> tuple[list[Method], Any]:
+    """The members to check and the config value that built them (``None``: given)."""
+    uav = {"planner": {"horizon": setup.planner.horizon}}
+    path = f"methods.{cls.config_key}"
+    if members is not None:
+        built = list(members)
+        with c.step("config"):
+            for m in built:
+                c.that(
+                    isinstance(m, cls),
+                    "config",
+                    f"members must be instances of {cls.__name__}, got {m!r}",
+                )
+    else:
+        if value is None:
+            value = _example_value(cls, uav)
+            c.that(
+                value is not None,
+                "config",
+                "no member to check: the family has no `example`, no small schema-valid "
+                "value builds members and its default builds none (pass members= or value=)",
+            )
+        with c.step("config"):
+            errors = list(_validator(cls.schema)(cls.schema).iter_errors(value))
+            c.that(
+                not errors,
+                "config",
+                f"{value!r} is not valid against the schema: "
+                + "; ".join(e.message for e in errors),
+            )
+            problems = cls.config_problems(value, path, uav)
+            c.that(
+                isinstance(problems, list) and not problems,
+                "config",
+                f"config_problems of {value!r}: {problems!r}",
+            )
+            built = list(cls.from_config(value, path))
+            for m in built:
+                c.that(
+                    isinstance(m, cls),
+                    "config",
+                    f"from_config must build {cls.__name__} members, got {m!r}",
+                )
+    c.that(bool(built), "config", "no member to check")
+    return built, value
+
+
+def _check_registry_config(c: _Checker, cls: type[Method], built: list[Method], value: Any) -> None:
+    """The registry builds the family's members of ``value`` among the others' defaults
+    (unique names, table order) and counts them."""
+    path = f"methods.{cls.config_key}"
+    with c.step("registry config"):
+        via = registry.from_config({cls.config_key: value}, "methods")
+        mine = [m for m in via.values() if type(m) is cls]
+        c.that(
+            sorted(mine, key=_safe_name) == sorted(built, key=_safe_name),
+            "registry config",
+            f"the registry's from_config builds {mine!r}, the family's {built!r}",
+        )
+        n = registry.count({cls.config_key: value}) - registry.count({})
+        n_default = len(cls.from_config(cls.default, path))
+        c.that(
+            n + n_default == len(built),
+            "registry config",
+            f"methods.count counts {n + n_default} members of {value!r}, "
+            f"from_config builds {len(built)}",
+        )
+
+
+def _example_value(cls: type[Method], uav: Mapping[str, Any]) -> Any:
+    """The config value of the members checked by default (module docstring), or ``None``."""
+    candidates: list[Any] = []
+    if hasattr(cls, "example"):
+        candidates.append(cls.example)
+    try:
+        candidates += _schema_examples(cls.schema)
+    except Exception:  # an unusual schema: fall back to the default
+        pass
+    candidates.append(cls.default)
+    for value in candidates:
+        try:
+            if not _validator(cls.schema)(cls.schema).is_valid(value):
+                continue
+            if cls.config_problems(value, "x", uav):
+                continue
+            if cls.from_config(value, "x"):
+                return value
+        except Exception:
+            continue
+    return None
+
+
+#: the small numbers tried first for an integer or number of a schema
+_SMALL = (4, 8, 16, 2, 1, 32, 64, 3, 5, 6)
+
+
+def _schema_examples(schema: Mapping[str, Any]) -> list[Any]:
+    """Small values for ``schema``, preferred first (not all of them valid)."""
+    if "enum" in schema:
+        return list(schema["enum"])
+    if "const" in schema:
+        return [schema["const"]]
+    kind = schema.get("type")
+    ok = _validator(schema)(schema).is_valid
+    if kind == "boolean":
+        return [True]
+    if kind in ("integer", "number"):
+        return [v for v in _SMALL if ok(v)][:3]
+    if kind == "array":
+        items = [v for v in _schema_examples(schema.get("items", {})) if ok([v])]
+        return [items[:2], items[:1]] if items else []
+    if kind == "object":
+        props = schema.get("properties", {})
+        required = list(schema.get("required", []))
+        options = {k: _schema_examples(props.get(k, {})) for k in required}
+        if any(not v for v in options.values()):
+            return []
+        first = {k: v[0] for k, v in options.items()}
+        out = [first]
+        for k, v in options.items():  # a second object: the first field that can differ
+            if len(v) > 1:
+                out.append({**first, k: v[1]})
+                break
+        return out
+    return []
+
+
+def _check_members(c: _Checker, cls: type[Method], built: list[Method]) -> None:
+    names: list[str] = []
+    for m in built:
+        with c.step("names", m):
+            name = m.name
+            c.that(
+                isinstance(name, str) and _NAME.fullmatch(name) is not None,
+                "names",
+                f"name must be a non-empty string of [A-Za-z0-9_.-], got {name!r}",
+                m,
+            )
+            names.append(name)
+            for other in registry.families():
+                if other is cls:
+                    continue
+                claimed = other.parse(name)
+                c.that(
+                    claimed is None,
+                    "names",
+                    f"the name is also a name of family {other.family!r} ({claimed!r})",
+                    m,
+                )
+    dup = sorted({n for n in names if names.count(n) > 1})
+    c.that(not dup, "names", f"names {dup} are not unique across the members")
+    keys: dict[str, str] = {}
+    for m in built:
+        with c.step("round trip", m):
+            c.that(hash(m) == hash(m), "round trip", "not hashable", m)
+            back = registry.from_name(m.name)
+            c.that(back == m, "round trip", f"from_name(name) gives {back!r}, not {m!r}", m)
+            spec = m.spec()
+            c.that(isinstance(spec, Mapping), "spec", f"spec() must be a dict, got {spec!r}", m)
+            again = registry.from_spec(spec)
+            c.that(again == m, "round trip", f"from_spec(spec()) gives {again!r}", m)
+        with c.step("spec", m):
+            c.that(
+                spec.get("family") == cls.family,
+                "spec",
+                f"spec()['family'] must be {cls.family!r}, got {spec.get('family')!r}",
+                m,
+            )
+            json.dumps(spec)
+        with c.step("columns", m):
+            cols = m.columns()
+            c.that(
+                isinstance(cols, Mapping) and set(cols) == set(COLUMNS),
+                "columns",
+                f"columns() must have exactly the keys {list(COLUMNS)}, got {cols!r}",
+                m,
+            )
+            for k, v in cols.items():
+                c.that(
+                    isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= 0,
+                    "columns",
+                    f"columns()[{k!r}] must be an int >= 0, got {v!r}",
+                    m,
+                )
+        with c.step("job_key", m):
+            key = m.job_key()
+            c.that(isinstance(key, Mapping), "job_key", f"must be a dict, got {key!r}", m)
+            text = json.dumps(key, sort_keys=True)
+            c.that(
+                key.get("method") == m.name,
+                "job_key",
+                f"job_key()['method'] must be the name {m.name!r}, got {key.get('method')!r}",
+                m,
+            )
+            bad = [k for k in _RESERVED_KEYS if k in key]
+            c.that(not bad, "job_key", f"holds the closed loop's own key(s) {bad}", m)
+            c.that(
+                text not in keys,
+                "job_key",
+                f"the same job key as member {keys.get(text)!r}: they would draw the same streams",
+                m,
+            )
+            keys[text] = m.name
+            job_rng(SEED, "uav_plan", run=0, step=1, **key)
+        with c.step("presentation", m):
+            label = m.label()
+            c.that(
+                isinstance(label, str) and label.strip() != "",
+                "presentation",
+                f"label() must be a non-empty string, got {label!r}",
+                m,
+            )
+            size = m.shade_size()
+            c.that(
+                size is None
+                or (isinstance(size, int | np.integer) and not isinstance(size, bool) and size > 0),
+                "presentation",
+                f"shade_size() must be None or an int > 0, got {size!r}",
+                m,
+            )
+            colour = palette.member_colour(m)
+            c.that(
+                palette.method_colour(m.name) == colour,
+                "presentation",
+                f"method_colour(name) is {palette.method_colour(m.name)!r}, the member's "
+                f"colour {colour!r}",
+                m,
+            )
+            sorted([m, *built], key=lambda x: x.sort_key())
+
+
+# ------------------------------------------------------------------------- hypotheses
+
+
+def _stream(m: Method, seed: int = SEED) -> np.random.Generator:
+    """The member's stream of the first planning step of run 0 (as the closed loop builds
+    it)."""
+    return job_rng(seed, "uav_plan", run=0, step=1, **m.job_key())
+
+
+def _copy(belief: Belief) -> Belief:
+    return Belief(
+        *(np.array(a, dtype=float, copy=True) for a in (belief.uav, belief.x_hat, belief.P_hat))
+    )
+
+
+def _same_belief(a: Belief, b: Belief) -> bool:
+    return all(
+        np.array_equal(x, y) for x, y in ((a.uav, b.uav), (a.x_hat, b.x_hat), (a.P_hat, b.P_hat))
+    )
+
+
+def _same_hypotheses(a: Hypotheses, b: Hypotheses) -> bool:
+    if (a.noise is None) != (b.noise is None):
+        return False
+    same = np.array_equal(a.states, b.states) and np.array_equal(a.weights, b.weights)
+    return same and (a.noise is None or np.array_equal(a.noise, b.noise))
+
+
+@contextmanager
+def _global_random_state(seed: int) -> Iterator[None]:
+    """numpy's and Python's global random generators seeded with ``seed``, restored after."""
+    np_state, py_state = np.random.get_state(), random.getstate()  # noqa: NPY002
+    np.random.seed(seed)  # noqa: NPY002
+    random.seed(seed)
+    try:
+        yield
+    finally:
+        np.random.set_state(np_state)  # noqa: NPY002
+        random.setstate(py_state)
+
+
+def _validate_hypotheses(
+    c: _Checker, m: Method, hyp: Any, belief: Belief, setup: UAVSetup, prop: str
+) -> None:
+    H = setup.planner.horizon
+    c.that(
+        isinstance(hyp, Hypotheses),
+        prop,
+        f"must be rsmhp.models.uav.methods.Hypotheses, got {type(hyp).__name__}",
+        m,
+    )
+    s = np.asarray(hyp.states)
+    c.that(
+        s.ndim == 3 and s.shape[0] >= 1 and s.shape[1:] == (H, 4),
+        prop,
+        f"states must have shape (T, H, 4) = (T, {H}, 4) with T >= 1, got {s.shape}",
+        m,
+    )
+    c.that(bool(np.isfinite(s).all()), prop, "states are not all finite", m)
+    w = np.asarray(hyp.weights)
+    T = s.shape[0]
+    c.that(w.shape == (T,), "weights", f"weights must have shape ({T},), got {w.shape}", m)
+    c.that(bool(np.isfinite(w).all()), "weights", "weights are not all finite", m)
+    c.that(bool((w >= 0).all()), "weights", f"weights must be >= 0, min {w.min()!r}", m)
+    total = float(w.sum())
+    c.that(
+        abs(total - 1.0) <= WEIGHT_TOL,
+        "weights",
+        f"weights sum to one: sum is {total!r} (|sum - 1| = {abs(total - 1.0):.3g} > "
+        f"{WEIGHT_TOL:g})",
+        m,
+    )
+    if hyp.noise is None:
+        return
+    n = np.asarray(hyp.noise)
+    c.that(
+        n.shape == (T, H + 1, 4),
+        prop,
+        f"noise must be None or of shape (T, H + 1, 4) = ({T}, {H + 1}, 4), got {n.shape}",
+        m,
+    )
+    c.that(bool(np.isfinite(n).all()), prop, "noise is not all finite", m)
+    F = setup.target.F
+    x = np.asarray(belief.x_hat, dtype=float) + n[:, 0]
+    scale = max(1.0, float(np.abs(s).max()))
+    for j in range(H):
+        x = x @ F.T + n[:, j + 1]
+        err = float(np.abs(x - s[:, j]).max())
+        c.that(
+            err <= 1e-9 * scale,
+            prop,
+            f"noise does not reproduce the states (x_0 = x_hat + noise[:, 0], x_j = F x_(j-1) "
+            f"+ noise[:, j]): max error {err:.3g} at step {j + 1}",
+            m,
+        )
+
+
+def _check_hypotheses(
+    c: _Checker, m: Method, built: list[Method], setup: UAVSetup, belief: Belief
+) -> None:
+    uses = m.uses_rng
+    with c.step("hypotheses", m):
+        before = _copy(belief)
+        hyp = m.hypotheses(belief, setup, _stream(m))
+        c.that(_same_belief(belief, before), "hypotheses", "hypotheses() modified the belief", m)
+        _validate_hypotheses(c, m, hyp, belief, setup, "hypotheses")
+    with c.step("determinism", m):
+        again = m.hypotheses(belief, setup, _stream(m))
+        c.that(
+            _same_hypotheses(hyp, again),
+            "determinism",
+            "the same stream seed gives different hypotheses",
+            m,
+        )
+        fresh = registry.from_spec(m.spec())
+        c.that(
+            _same_hypotheses(hyp, fresh.hypotheses(belief, setup, _stream(m))),
+            "determinism",
+            "an equal fresh member (from_spec) draws other hypotheses from the same stream",
+            m,
+        )
+        if uses:
+            other = m.hypotheses(belief, setup, _stream(m, SEED + 1))
+            c.that(
+                not _same_hypotheses(hyp, other),
+                "determinism",
+                "uses_rng is True but another stream seed gives identical hypotheses",
+                m,
+            )
+        else:
+            none = m.hypotheses(belief, setup, None)
+            c.that(
+                _same_hypotheses(hyp, none),
+                "determinism",
+                "uses_rng is False but hypotheses(rng=None) differ from those with a stream",
+                m,
+            )
+    with c.step("stream independence", m):
+        with _global_random_state(1):
+            a = m.hypotheses(belief, setup, _stream(m) if uses else None)
+        with _global_random_state(2):
+            b = m.hypotheses(belief, setup, _stream(m) if uses else None)
+        c.that(
+            _same_hypotheses(a, b) and _same_hypotheses(a, hyp),
+            "stream independence",
+            "the hypotheses depend on numpy's or Python's global random state, not only on "
+            "the member's stream",
+            m,
+        )
+        # the other members draw in between (and a call with another seed): nothing carries over
+        others = [o for o in built if o != m]
+        baseline = registry.baseline()()
+        for o in [*others, baseline]:
+            if o.estimates_cost:
+                o.hypotheses(belief, setup, _stream(o) if o.uses_rng else None)
+        m.hypotheses(belief, setup, _stream(m, SEED + 2))
+        c.that(
+            _same_hypotheses(m.hypotheses(belief, setup, _stream(m)), hyp),
+            "stream independence",
+            "the hypotheses changed after other members' draws (state carried between calls)",
+            m,
+        )
+
+
+# ---------------------------------------------------------------------------- planning
+
+
+def _check_plan(c: _Checker, m: Method, setup: UAVSetup, belief: Belief) -> float:
+    H = setup.planner.horizon
+    uses = m.uses_rng
+    with c.step("planner", m):
+        planner = m.planner(setup)
+        c.that(
+            isinstance(planner, Planner),
+            "planner",
+            f"planner(setup) must have plan(belief, warm_start, rng), got {type(planner).__name__}",
+            m,
+        )
+    with c.step("plan", m):
+        warm = np.zeros((H, 2))
+        before = _copy(belief)
+        with _global_random_state(1):
+            t0 = time.perf_counter()
+            res = planner.plan(belief, warm, _stream(m) if uses else None)
+            seconds = time.perf_counter() - t0
+        c.that(_same_belief(belief, before), "plan", "plan() modified the belief", m)
+        c.that(bool((warm == 0).all()), "plan", "plan() modified the warm start", m)
+        _validate_plan(c, m, res, setup, belief)
+        if type(m).planner is Method.planner and m.estimates_cost:
+            own = m.hypotheses(belief, setup, _stream(m) if uses else None)
+            c.that(
+                res.hypotheses is not None and _same_hypotheses(res.hypotheses, own),
+                "plan",
+                "the default planner did not plan over the member's hypotheses of its stream",
+                m,
+            )
+    with c.step("plan determinism", m):
+        with _global_random_state(2):
+            again = planner.plan(belief, np.zeros((H, 2)), _stream(m) if uses else None)
+        diffs = [
+            f
+            for f in ("controls", "cost", "nit", "n_kernel_calls", "work", "uav_path")
+            if not np.array_equal(getattr(res, f), getattr(again, f))
+        ]
+        c.that(
+            not diffs,
+            "plan determinism",
+            f"planning again with the same stream (and other global random state) changed {diffs}",
+            m,
+        )
+    return seconds
+
+
+def _validate_plan(c: _Checker, m: Method, res: Any, setup: UAVSetup, belief: Belief) -> None:
+    H = setup.planner.horizon
+    prop = "plan"
+    c.that(
+        isinstance(res, PlanResult),
+        prop,
+        f"plan() must return a PlanResult, got {type(res).__name__}",
+        m,
+    )
+    u = np.asarray(res.controls)
+    c.that(u.shape == (H, 2), prop, f"controls must have shape ({H}, 2), got {u.shape}", m)
+    c.that(bool(np.isfinite(u).all()), prop, "controls are not all finite", m)
+    scale = np.asarray(setup.uav.control_scale, dtype=float)
+    excess = float((np.abs(u) - scale * (1 + 1e-12)).max())
+    c.that(
+        excess <= 0,
+        prop,
+        f"controls leave the bounds ±{scale.tolist()} (by {excess:.3g})",
+        m,
+    )
+    path = np.asarray(res.uav_path)
+    c.that(path.shape == (H, 4), prop, f"uav_path must have shape ({H}, 4), got {path.shape}", m)
+    ref = rollout(np.asarray(belief.uav, dtype=float), u, setup.uav)
+    c.that(
+        np.allclose(path, ref, rtol=1e-9, atol=1e-6),
+        prop,
+        f"uav_path is not the rollout of the controls (max error {np.abs(path - ref).max():.3g})",
+        m,
+    )
+    c.that(
+        isinstance(res.cost, float | np.floating) and math.isfinite(res.cost),
+        prop,
+        f"cost must be a finite float, got {res.cost!r}",
+        m,
+    )
+    c.that(
+        isinstance(res.cost_warm, float | np.floating),
+        prop,
+        f"cost_warm must be a float (NaN if unknown), got {res.cost_warm!r}",
+        m,
+    )
+    for f in ("nit", "n_kernel_calls", "work"):
+        v = getattr(res, f)
+        c.that(
+            isinstance(v, int | np.integer) and not isinstance(v, bool) and v >= 0,
+            prop,
+            f"{f} must be an int >= 0, got {v!r}",
+            m,
+        )
+    c.that(
+        res.work > 0,
+        prop,
+        "work (the step's compute in model steps) must be reported (> 0), got 0",
+        m,
+    )
+    c.that(
+        res.converged is None or isinstance(res.converged, bool | np.bool_),
+        prop,
+        f"converged must be None or a bool, got {res.converged!r}",
+        m,
+    )
+    d = res.diagnostics
+    c.that(isinstance(d, Mapping), prop, f"diagnostics must be a dict, got {d!r}", m)
+    for k, v in d.items():
+        c.that(
+            isinstance(k, str) and isinstance(v, float | int | np.floating | np.integer),
+            prop,
+            f"diagnostics must map names to floats, got {k!r}: {v!r}",
+            m,
+        )
+    if res.hypotheses is not None:
+        _validate_hypotheses(c, m, res.hypotheses, belief, setup, prop)
