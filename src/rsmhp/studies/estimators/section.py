@@ -1,11 +1,14 @@
 """The estimator study's report section: the body (what was run, symbols, findings, figures),
 the appendix (why the findings hold, the samplers beyond the paper, every table) and the
 Markdown tables, from the statistics of :mod:`rsmhp.studies.estimators.summarise` and the claims of
-:mod:`rsmhp.studies.estimators.claims`."""
+:mod:`rsmhp.studies.estimators.claims`. The prose lives in the templates ``section.md`` (body) and
+``appendix.md`` beside this module (:func:`rsmhp.report.templates.render`); this module computes
+and formats the values they print."""
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -13,6 +16,7 @@ import pandas as pd
 
 from rsmhp.report.ledger import Section
 from rsmhp.report.markdown import fmt, fmt_ci, markdown_table
+from rsmhp.report.templates import render
 from rsmhp.studies.estimators.claims import claims, k_text, range_text
 from rsmhp.studies.estimators.summarise import (
     MIN_TREE_SIZES,
@@ -34,7 +38,22 @@ from rsmhp.studies.estimators.summarise import (
     weighted_fractions_all,
 )
 
-__all__ = ["ABSENT", "FIGURES", "estimators_section", "gain_table", "tables"]
+__all__ = [
+    "ABSENT",
+    "FIGURES",
+    "ChebyshevText",
+    "ExactRulesText",
+    "Findings",
+    "LeafRatioText",
+    "PruningText",
+    "RunText",
+    "SobolText",
+    "WeightedCellsText",
+    "WeightingText",
+    "estimators_section",
+    "gain_table",
+    "tables",
+]
 
 #: the figures the section shows, in order (drawn by :mod:`rsmhp.studies.estimators.figures`)
 FIGURES = (
@@ -181,135 +200,180 @@ def tables(df: pd.DataFrame, s: pd.DataFrame, cheb: pd.DataFrame) -> dict[str, s
 
 # --- the body -------------------------------------------------------------------------------
 
+#: the package whose ``section.md`` and ``appendix.md`` hold the prose
+_TEMPLATES = "rsmhp.studies.estimators"
 
-def _tree_findings(s: pd.DataFrame) -> list[str]:
-    out = []
-    sl = tree_slopes(s)
-    counted = sl[sl["counted"]]
-    if len(counted):
-        out.append(
-            f"The shared tree's variance falls like 1/N (slopes {range_text(counted['slope'], 3)} "
-            f"where >= {MIN_TREE_SIZES} sizes ran), not 1/N^H: its leaves reuse N·H draws."
+
+def _render(template: str, **values: Any) -> str:
+    """``template`` filled with ``values``; the file's final newline is not part of the
+    section text."""
+    return render(_TEMPLATES, template, **values).removesuffix("\n")
+
+
+@dataclass(frozen=True)
+class RunText:
+    """What was run, printed: the problems with their horizons (``lqg_paper (H=2), ...``),
+    the replicates per cell and plain MC's largest n (0 without MC cells)."""
+
+    problems: str
+    replicates: int
+    n_max: int
+
+    @classmethod
+    def of(cls, s: pd.DataFrame) -> RunText:
+        """The run summarised in ``s``."""
+        hs = s.groupby("problem", sort=False)["H"].first()
+        mc = select(s, "mc")
+        return cls(
+            problems=", ".join(f"{p} (H={int(hs[p])})" for p in dict.fromkeys(s["problem"])),
+            replicates=int(s["n_replicates"].max()),
+            n_max=int(mc["n_trajectories"].max()) if len(mc) else 0,
         )
+
+
+@dataclass(frozen=True)
+class LeafRatioText:
+    """Var(shared tree) / Var(independent) at the largest leaf count ``leaves`` (range over the
+    problems run at it)."""
+
+    leaves: int
+    ratio: str
+
+
+@dataclass(frozen=True)
+class WeightingText:
+    """The weighted tree's f = (mean - J)/(J(Σ/2) - J) at each problem's largest N: the
+    problems whose CI of f contains 1 (``reached``) and those whose CI lies below 1
+    (``short``, with N and f); "" where there are none."""
+
+    reached: str
+    short: str
+
+
+@dataclass(frozen=True)
+class PruningText:
+    """The pruned tree's bias as a share of J_NBO - J (range, in %) at the largest N = ``n``."""
+
+    n: int
+    bias: str
+
+
+@dataclass(frozen=True)
+class ChebyshevText:
+    """Plain MC's Chebyshev cells: ``below`` of ``cells`` (problem, n, k) cells have the upper
+    CI limit of the exceedance frequency below the bound 1/k²; the exact probability over the
+    bound (range); the slopes of log Var vs log n (range; None without a fit)."""
+
+    below: int
+    cells: int
+    ratio: str
+    slopes: str | None
+
+
+@dataclass(frozen=True)
+class SobolText:
+    """RMSE of plain MC / RMSE of Sobol' (range over the problems) at n = ``n``."""
+
+    ratio: str
+    n: int
+
+
+@dataclass(frozen=True)
+class Findings:
+    """The numbers of the body's findings, printed; a finding whose data do not exist is None
+    and its sentence is left out. ``tree_slopes``: range of the shared tree's counted slopes of
+    log Var vs log N (run at >= ``min_tree_sizes`` sizes)."""
+
+    tree_slopes: str | None
+    min_tree_sizes: int
+    leaf_ratio: LeafRatioText | None
+    weighting: WeightingText | None
+    pruning: PruningText | None
+    chebyshev: ChebyshevText | None
+    sobol: SobolText | None
+
+
+def _tree_findings(s: pd.DataFrame) -> tuple[str | None, LeafRatioText | None]:
+    """The range of the shared tree's counted variance slopes and its variance ratio to
+    independent sampling at the largest leaf count (None where absent)."""
+    counted = tree_slopes(s)
+    counted = counted[counted["counted"]]
     head = largest_leaf_ratios(s)
+    leaf_ratio = None
     if len(head):
-        r = head.loc[head["leaves"].idxmax()]
-        out.append(
-            f"At {int(r['leaves'])} leaves its variance is "
-            f"{range_text(head[head['leaves'] == r['leaves']]['ratio_measured'], 2)} times that "
-            "of as many independent trajectories."
+        leaves = head.loc[head["leaves"].idxmax(), "leaves"]
+        leaf_ratio = LeafRatioText(
+            leaves=int(leaves),
+            ratio=range_text(head[head["leaves"] == leaves]["ratio_measured"], 2),
         )
-    return out
+    return (range_text(counted["slope"], 3) if len(counted) else None), leaf_ratio
 
 
-def _weighting_finding(s: pd.DataFrame) -> list[str]:
+def _weighting_finding(s: pd.DataFrame) -> WeightingText | None:
+    """Where the weighted tree's f stands at each problem's largest N (None without one)."""
     wf = weighted_fractions(s)
     if not len(wf):
-        return []
+        return None
     last = wf.loc[wf.groupby("problem", sort=False)["N"].idxmax()]
     reached = last[(last["f_low"] <= 1) & (last["f_high"] >= 1)]
     short = last[last["f_high"] < 1]
-    txt = (
-        "Likeliness weighting multiplies N(0, Σ) by its own density, i.e. samples "
-        "N(0, Σ/2): f = (mean - J)/(J(Σ/2) - J) of the weighted tree grows from 0 at N = 1 "
-        "toward 1 as N grows (a trend; no finite-N closed form)"
+    return WeightingText(
+        reached=_and(reached["problem"]) if len(reached) else "",
+        short=(
+            _and(
+                f"{r['problem']} (N = {int(r['N'])}, f = {fmt(r['f'], 2)})"
+                for _, r in short.iterrows()
+            )
+            if len(short)
+            else ""
+        ),
     )
-    if len(reached):
-        txt += f"; at the largest N its CI contains 1 for {_and(reached['problem'])}"
-    if len(short):
-        txt += ", but the tree is not yet at its limit for " + _and(
-            f"{r['problem']} (N = {int(r['N'])}, f = {fmt(r['f'], 2)})" for _, r in short.iterrows()
-        )
-    return [txt + "."]
 
 
-def _other_findings(s: pd.DataFrame, cheb: pd.DataFrame) -> list[str]:
-    out = []
+def _chebyshev_finding(s: pd.DataFrame, cheb: pd.DataFrame) -> ChebyshevText | None:
+    """Plain MC's exceedances against Chebyshev's bound (None without Chebyshev cells)."""
+    if not len(cheb):
+        return None
+    rate = [f.slope for f in mc_variance_slopes(s).values()]
+    return ChebyshevText(
+        below=int((cheb["high"] < cheb["bound"]).sum()),
+        cells=len(cheb),
+        ratio=range_text(cheb["exact"] / cheb["bound"], 2),
+        slopes=range_text(rate, 3) if rate else None,
+    )
+
+
+def _findings(s: pd.DataFrame, cheb: pd.DataFrame) -> Findings:
+    """The numbers of the body's findings paragraph, each only if its data exist."""
+    tree_slopes_text, leaf_ratio = _tree_findings(s)
     top = pruning_at_largest_n(s)
-    if len(top):
-        out.append(
-            "Pruning with M fixed keeps draws ever nearer the mode as N grows, so the estimate "
-            f"tends to the NBO cost J_NBO: at N = {int(top['N'].max())} its bias is "
-            f"{range_text(top['bias_fraction_of_nbo'] * 100, 2, '%')} of J_NBO - J."
-        )
-    if len(cheb):
-        rate = [f.slope for f in mc_variance_slopes(s).values()]
-        out.append(
-            "Plain MC's exceedance frequency is below Chebyshev's bound (upper CI limit) in "
-            f"{int((cheb['high'] < cheb['bound']).sum())}/{len(cheb)} (problem, n, k) cells, "
-            "and the exact probability (a generalised chi-square) lies at "
-            f"{range_text(cheb['exact'] / cheb['bound'], 2)} × the bound"
-            + (f"; its variance slope vs n is {range_text(rate, 3)}." if rate else ".")
-        )
     big = sobol_rmse_ratios(s)
-    if len(big):
-        out.append(
-            f"Sobol' points cut the RMSE {range_text(big['ratio'], 2)} times "
-            f"against MC at n = {int(big['n_trajectories'].iloc[0])}; cubature and "
-            "Gauss-Hermite are exact for these quadratic costs."
-        )
-    return out
-
-
-def _findings(s: pd.DataFrame, cheb: pd.DataFrame) -> list[str]:
-    """Sentences of the body's findings paragraph, each built only if its data exist."""
-    return [*_tree_findings(s), *_weighting_finding(s), *_other_findings(s, cheb)]
-
-
-_SYMBOLS = (
-    "**Symbols.** H: horizon; n: trajectories averaged (a tree's leaves); mc: n "
-    "independent trajectories; tree: N draws per level shared by every node of the level "
-    "(N^H leaves); tree_pernode: N fresh draws at every node; pruned: keeps the M most "
-    "likely partial trajectories (product of draw densities) per level; weighted: "
-    "average with normalised likeliness. The stacked noise w = (w_0..w_{H-1}) ~ N(0, S), "
-    "S = I_H ⊗ Σ, Σ the per-step noise covariance; each trajectory cost is "
-    "g(w) = c + bᵀw + wᵀKw, so J = c + tr(KS), the NBO (nominal-trajectory) cost J_NBO = c,"
-    " and J(Σ/2) = c + tr(KS)/2 is J with Σ halved."
-)
-
-#: (alt text, caption) of each figure of :data:`FIGURES`
-_CAPTIONS = (
-    ("RMSE vs n", "RMSE (95% CI) vs n; pruned at its largest N (n = M)."),
-    ("bias vs n", "Bias / (J_NBO - J): 0 unbiased, 0.5 J(Σ/2), 1 the NBO cost."),
-    (
-        "tree variance",
-        "Variance vs leaves: shared tree, per-node tree, independent; dashed: derived.",
-    ),
-    (
-        "weighted vs uniform",
-        "Mean (95% CI): uniform on J; weighted (dotted) below J, approaching J(Σ/2) as n grows.",
-    ),
-    ("pruning", "Pruned tree: bias / (J_NBO - J) over (N, M); colour clipped to [0, 1]."),
-    ("frontier", "RMSE vs CPU time per estimate (this run's timings; they vary per run)."),
-)
-
-
-def _run_text(s: pd.DataFrame) -> str:
-    reps = int(s["n_replicates"].max())
-    hs = s.groupby("problem", sort=False)["H"].first()
-    prob_txt = ", ".join(f"{p} (H={int(hs[p])})" for p in dict.fromkeys(s["problem"]))
-    mc = select(s, "mc")
-    n_max = int(mc["n_trajectories"].max()) if len(mc) else 0
-    return (
-        "**Run.** Every estimator of the paper, and samplers it does not use (antithetic "
-        "pairs w, -w; scrambled Sobol' quasi-random points; cubature and Gauss-Hermite "
-        f"quadrature), on problems with an exactly known expected cost J: {prob_txt} "
-        "(lqg_*: scalar oven LQG, lqg_paper the paper's setting; ncv*: 2-D point mass). "
-        f"{reps} seeded replicates per cell, n <= {n_max}."
+    return Findings(
+        tree_slopes=tree_slopes_text,
+        min_tree_sizes=MIN_TREE_SIZES,
+        leaf_ratio=leaf_ratio,
+        weighting=_weighting_finding(s),
+        pruning=(
+            PruningText(
+                n=int(top["N"].max()),
+                bias=range_text(top["bias_fraction_of_nbo"] * 100, 2, "%"),
+            )
+            if len(top)
+            else None
+        ),
+        chebyshev=_chebyshev_finding(s, cheb),
+        sobol=(
+            SobolText(ratio=range_text(big["ratio"], 2), n=int(big["n_trajectories"].iloc[0]))
+            if len(big)
+            else None
+        ),
     )
 
 
 def _body(s: pd.DataFrame, cheb: pd.DataFrame) -> str:
-    parts = [
-        _run_text(s),
-        _SYMBOLS,
-        "**Found.** " + " ".join(_findings(s, cheb)),
-        "Figures: weighted variants dotted, derived values dashed; y ranges follow the point "
-        "estimates, CI bars beyond are cut (count in the panel title).",
-    ]
-    for name, (alt, caption) in zip(FIGURES, _CAPTIONS, strict=True):
-        parts += [f"![{alt}](figures/{name}.png)", f"*{caption}*"]
-    return "\n\n".join(parts)
+    """What was run, the symbols, the findings and the figures with their captions
+    (``section.md``)."""
+    return _render("section.md", run=RunText.of(s), found=_findings(s, cheb))
 
 
 def estimators_section(
@@ -332,100 +396,64 @@ def estimators_section(
 # --- the appendix ---------------------------------------------------------------------------
 
 
-def _weighted_note(s: pd.DataFrame) -> str:
-    """Where the measured f of every weighted cell lies relative to [0, 1] (within its CI)."""
+@dataclass(frozen=True)
+class WeightedCellsText:
+    """Where the measured f of every weighted cell lies relative to [0, 1] (within its 95%
+    CI): ``inside`` of ``cells`` cells meet it; ``outside`` names the others with f and its
+    CI."""
+
+    inside: int
+    cells: int
+    outside: tuple[str, ...]
+
+
+@dataclass(frozen=True)
+class ExactRulesText:
+    """The quadrature rules (cubature, Gauss-Hermite): ``cells`` cells run, their largest
+    relative error |bias| / max(|J|, 1)."""
+
+    cells: int
+    error: str
+
+
+def _weighted_cells(s: pd.DataFrame) -> WeightedCellsText | None:
+    """Where f of every weighted cell lies relative to [0, 1] (None without weighted cells)."""
     wf = weighted_fractions_all(s)
     if wf.empty:
-        return ""
+        return None
     inside = wf["in_unit_interval"]
-    out = (
-        f"The measured f lies between 0 and 1 (within its 95% CI) in {int(inside.sum())} of "
-        f"{len(wf)} weighted cells and tends to grow with N or n"
-    )
-    odd = wf[~inside]
-    if len(odd):
-        out += "; outside: " + ", ".join(
+    return WeightedCellsText(
+        inside=int(inside.sum()),
+        cells=len(wf),
+        outside=tuple(
             f"{r['scheme']} {r['problem']} n = {int(r['n_trajectories'])} (f = {fmt(r['f'], 4)} "
             f"{fmt_ci(r['f_low'], r['f_high'], 4)})"
-            for _, r in odd.iterrows()
-        )
-        out += f", about what {len(wf)} intervals at 95% leave outside by chance"
-    return out + "."
+            for _, r in wf[~inside].iterrows()
+        ),
+    )
 
 
-def _exact_note(s: pd.DataFrame) -> str:
+def _exact_rules(s: pd.DataFrame) -> ExactRulesText | None:
+    """The quadrature rules' cells and largest relative error (None if none ran)."""
     err = exact_rule_error(s)
     if err is None:
-        return ""
+        return None
     cells, rel = err
-    return (
-        f"Cubature (2·H·d sigma points, d = noise dimension) and Gauss-Hermite (q^(H·d) points) "
-        f"ran once per problem and size ({cells} cells) and reproduce J to a relative error of "
-        f"at most {fmt(rel, 2)}, i.e. floating-point rounding: both are exact for quadratic "
-        "costs, so they appear as *exact* and not as an RMSE gain (a ratio with a rounding error "
-        "in the denominator carries no information). This says nothing about non-polynomial "
-        "costs such as the UAV planner's."
-    )
-
-
-def _why(s: pd.DataFrame) -> list[str]:
-    """The appendix's explanations: why the tree converges slowly, why weighting is biased,
-    why pruning tends to NBO, and the samplers beyond the paper."""
-    anti_txt = ", ".join(f"{p} {fmt(r, 3)}" for p, r in antithetic_ratios(s).items())
-    return [
-        "Verdict rules in full: docstring of `rsmhp.studies.estimators.claims`. Every number here "
-        "except CPU times is bitwise reproducible (seeded draws and bootstrap).",
-        "**Why the tree converges slowly.** Every node of a level reuses the same N draws, so "
-        "the N^H leaves carry only N·H independent numbers. Averaging g over the product grid "
-        "gives the derived variance bᵀSb/N + 2tr((KS)²)/N² + 2(N-1)/N² Σ_k tr((K_kk Σ)²) "
-        "(K_kk: the k-th diagonal block of K), which falls like 1/N, not 1/N^H. The per-node "
-        "tree's leaves are correlated only through common prefixes; it falls faster.",
-        "**Why weighting is biased.** The likeliness of a draw is its density φ_Σ; weighting by "
-        "it turns N(0, Σ) into φ_Σ² ∝ N(0, Σ/2), so every weighted estimator tends to "
-        "J(Σ/2) = c + tr(KS)/2 as its sample grows. At finite N the self-normalised weights have "
-        "no closed-form mean; the two derived end points are N = 1 (one weight, mean J, f = 0) "
-        "and N -> infinity (f = 1). " + _weighted_note(s),
-        "**Why pruning tends to NBO.** The M most likely of N draws per level are the M nearest "
-        "the mode 0; as N grows with M fixed they shrink to 0 and the pruned estimate to g(0) = c, "
-        "the NBO cost.",
-        "**Samplers beyond the paper.** Antithetic pairs (w, -w) cancel the linear part bᵀw but "
-        "double the weight of the quadratic part: their variance relative to MC is "
-        f"4tr((KS)²)/Var(g) = {anti_txt} (derived), so they barely help here. Scrambled Sobol' "
-        "points (randomised quasi-Monte Carlo) gain most. " + _exact_note(s),
-    ]
-
-
-def _table_texts(s: pd.DataFrame, tabs: Mapping[str, str]) -> list[str]:
-    """Each appendix table with the sentence that introduces it."""
-    best = best_stochastic_gains(equal_cpu_gains(s))
-    best_txt = "; ".join(
-        f"{r['problem']} {r['scheme']} {fmt(r['gain_vs_mc'], 2)}x" for _, r in best.iterrows()
-    )
-    return [
-        "Weighted estimators at their largest size; f = (mean - J)/(J(Σ/2) - J):",
-        tabs["est_weighted"],
-        "Tree vs independent sampling at equal leaf counts (variance ratio tree / mc, measured "
-        "and derived):",
-        tabs["est_tree_vs_independent"],
-        f"Pruned tree (uniform), bias / (J_NBO - J) per kept count M and draws per level N; "
-        f"{ABSENT}: M > N, not run:",
-        tabs["est_pruning"],
-        "Prop. 3 at the largest n: frequency of |J_n - J| >= k·sd_n (sd_n derived) vs the "
-        "Chebyshev bound 1/k², with its Clopper-Pearson 95% CI:",
-        tabs["est_chebyshev"],
-        "Equal CPU time. CPU times are measurements of this run and differ between runs and "
-        "machines, so nothing here is a key number. Each scheme's best RMSE within the median "
-        "CPU time of plain MC's largest budget (its CPU-RMSE frontier at that time); gain = "
-        f"RMSE_mc / RMSE. Best stochastic sampler per problem: {best_txt or 'none'}. Exact rules "
-        "have no gain (see above).",
-        tabs["est_equal_cpu"],
-        "Each stochastic estimator at its largest size (full table: "
-        "`results/estimators/summary.csv`). size: N draws per level (trees), M kept (pruned); "
-        f"derived sd {ABSENT}: no closed form (weighted, Sobol', pruned). CPU ms vary per run:",
-        tabs["est_largest"],
-    ]
+    return ExactRulesText(cells=cells, error=fmt(rel, 2))
 
 
 def _appendix(s: pd.DataFrame, tabs: Mapping[str, str]) -> str:
-    """Why the findings hold, the samplers beyond the paper, and every table."""
-    return "\n\n".join([*_why(s), *_table_texts(s, tabs)])
+    """Why the findings hold, the samplers beyond the paper, and every table, each with the
+    sentence that introduces it (``appendix.md``)."""
+    best = best_stochastic_gains(equal_cpu_gains(s))
+    return _render(
+        "appendix.md",
+        weighted_cells=_weighted_cells(s),
+        exact_rules=_exact_rules(s),
+        antithetic=[f"{p} {fmt(r, 3)}" for p, r in antithetic_ratios(s).items()],
+        best_gains=[
+            f"{r['problem']} {r['scheme']} {fmt(r['gain_vs_mc'], 2)}x" for _, r in best.iterrows()
+        ],
+        absent=ABSENT,
+        tables=tabs,
+    )

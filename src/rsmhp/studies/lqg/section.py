@@ -1,12 +1,16 @@
 """LQG study (paper Sec. III-A, Fig. 3), report section: the Markdown tables, the short main
 text with the four figures and the appendix, assembled into a :class:`rsmhp.report.ledger.Section`
 from the claims of :mod:`rsmhp.studies.lqg.claims` and the statistics of
-:mod:`rsmhp.studies.lqg.summarise`.
+:mod:`rsmhp.studies.lqg.summarise`. The prose lives in the templates ``section.md`` (main text)
+and ``appendix.md`` beside this module (:func:`rsmhp.report.templates.render`); this module
+computes and formats the values they print.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -14,6 +18,7 @@ import pandas as pd
 from rsmhp.models.lqg import oven as lqg
 from rsmhp.report.ledger import Claim, Section
 from rsmhp.report.markdown import fmt, fmt_ci, markdown_table
+from rsmhp.report.templates import render
 from rsmhp.studies.lqg.claims import ci_digits, fmt_exact, lqg_claims
 from rsmhp.studies.lqg.summarise import (
     LinearCostCheck,
@@ -29,6 +34,10 @@ __all__ = [
     "FIGURES",
     "NBO_Z_CLIP",
     "TABLES",
+    "LinearText",
+    "ModelText",
+    "NboRunText",
+    "ResultsText",
     "chebyshev_table",
     "convergence_table",
     "lqg_section",
@@ -133,6 +142,15 @@ def lqg_tables(
 
 # -------------------------------------------------------------------------------- section
 
+#: the package whose ``section.md`` and ``appendix.md`` hold the prose
+_TEMPLATES = "rsmhp.studies.lqg"
+
+
+def _render(template: str, **values: Any) -> str:
+    """``template`` filled with ``values``; the file's final newline is not part of the
+    section text."""
+    return render(_TEMPLATES, template, **values).removesuffix("\n")
+
 
 def _p_text(summary: pd.DataFrame) -> str:
     """The P grid in words: ``P = 100, 200, ..., 10000`` (even steps) or ``P ∈ {...}``."""
@@ -143,156 +161,178 @@ def _p_text(summary: pd.DataFrame) -> str:
     return "P ∈ {" + ", ".join(str(p) for p in p_grid) + "}"
 
 
-def _setting_paragraph(summary: pd.DataFrame, nbo: pd.DataFrame, conv: pd.DataFrame) -> str:
-    """The model, the paper's setting and what we ran."""
-    u, model = model_from_table(conv)
-    reps = int(summary.iloc[-1]["n_replicates"])
-    return (
-        "Scalar oven problem of Sec. III-A: state x_k, control u_k, noise w_k ~ N(0, σ²), "
-        "x_{k+1} = (1-a) x_k + a u_k + w_k; cost J = E[r (x_H - T)² + Σ_{k<H} u_k²] with "
-        "weight r, target T, horizon H. NBO (nominal belief-state optimisation) sets every "
-        "w_k to 0 (cost J_NBO); MHP (multipath hypothesis propagation) averages the cost g "
-        "of P independent simulated trajectories (estimate J_P, variance "
-        f"Var(g)/P). Paper's setting: x_0 = {eps_label(model.x0)}, r = {eps_label(model.r)}, "
-        f"T = {eps_label(model.target)}, σ = {eps_label(model.sigma)}, H = {len(u)}, u = "
-        f"({', '.join(eps_label(v) for v in u)}), {_p_text(summary)}; a = "
-        f"{eps_label(model.a)} is our choice (the paper gives none). We ran {reps} independent "
-        f"replicates per P, and the NBO error on {nbo['a'].nunique()} values of a × "
-        f"{nbo['H'].nunique()} of H ({int(nbo['n_replicates'].iloc[0])} replicates of "
-        f"P = {int(nbo['P'].iloc[0])}, u_k = {eps_label(nbo['u_value'].iloc[0])})."
-    )
+@dataclass(frozen=True)
+class ModelText:
+    """The oven model of the convergence run, printed: the constants a, x_0, r, T, σ, the
+    open-loop controls u = (u_0, ..., u_{H-1}) (comma-separated) and the horizon H = len(u)."""
 
+    a: str
+    x0: str
+    r: str
+    target: str
+    sigma: str
+    u: str
+    horizon: int
 
-def _chebyshev_sentence(summary: pd.DataFrame, eps_values: Sequence[float], c3: Claim) -> str:
-    check = chebyshev_check(summary, eps_values)
-    t = check.test
-    return (
-        f"Over {t.cells} (P, ε) cells the count of |J_P - J| ≥ ε matches its exact "
-        f"probability (J_P is a generalised chi-square; {t.departing} cells depart, smallest "
-        f"adjusted p = {fmt(t.min_p, 3)})"
-        + (
-            f", and that probability is at most {fmt(t.max_exact_ratio, 2)} × Prop. 3's "
-            "Chebyshev bound Var(g)/(Pε²) where the bound is below 1"
-            if np.isfinite(t.max_exact_ratio)
-            else "; Prop. 3's Chebyshev bound Var(g)/(Pε²) is not below 1 in any cell"
+    @classmethod
+    def of(cls, conv: pd.DataFrame) -> ModelText:
+        """The model stamped in the convergence table ``conv``."""
+        u, model = model_from_table(conv)
+        return cls(
+            a=eps_label(model.a),
+            x0=eps_label(model.x0),
+            r=eps_label(model.r),
+            target=eps_label(model.target),
+            sigma=eps_label(model.sigma),
+            u=", ".join(eps_label(v) for v in u),
+            horizon=len(u),
         )
-    )
 
 
-def _linear_sentence(c: Claim | None) -> str:
-    if c is None:
-        return ""
-    return (
-        " On a linear-cost system, Prop. 3's own premise, the simulated variance of J_N "
-        f"matches the paper's formula C[Σ_k 𝒜_k Σ 𝒜_kᵀ]Cᵀ/N ({c.key.name} = "
-        f"{fmt(c.key.value, 3)}; LIN-1 {c.verdict})."
-    )
+@dataclass(frozen=True)
+class NboRunText:
+    """The NBO-error run, printed: ``n_a`` values of a × ``n_h`` of H, each cell ``replicates``
+    replicates of P = ``p`` trajectories under the constant control u_k = ``u``; ``limit`` is
+    the Bonferroni limit of |z| over its cells (LQG-1)."""
+
+    n_a: int
+    n_h: int
+    replicates: int
+    p: int
+    u: str
+    limit: str
+
+    @classmethod
+    def of(cls, nbo: pd.DataFrame) -> NboRunText:
+        """The run summarised in the NBO-error summary ``nbo``."""
+        return cls(
+            n_a=nbo["a"].nunique(),
+            n_h=nbo["H"].nunique(),
+            replicates=int(nbo["n_replicates"].iloc[0]),
+            p=int(nbo["P"].iloc[0]),
+            u=eps_label(nbo["u_value"].iloc[0]),
+            limit=fmt(nbo_z_limit(len(nbo)), 3),
+        )
 
 
-def _results_paragraph(
+@dataclass(frozen=True)
+class LinearText:
+    """The linear-cost check of Prop. 3 (LIN-1), printed: its key number and verdict."""
+
+    name: str
+    value: str
+    verdict: str
+
+
+@dataclass(frozen=True)
+class ResultsText:
+    """The numbers of the results paragraph, printed.
+
+    Closed forms J, J_NBO, Var(g) and the NBO error J - J_NBO = r σ² Σ_{n<H} (1-a)^{2n};
+    the OLS slope of log RMSE vs log P with its 95% CI (LQG-2); the RMSE at the largest P
+    = ``p`` and the NBO error in RMSEs; the largest |z| of the NBO-error checks over
+    ``nbo_checks`` checks (LQG-1); the exceedance test of |J_P - J| ≥ ε over ``cheb_cells``
+    (P, ε) cells, ``cheb_departing`` of them departing, smallest adjusted p ``cheb_min_p``,
+    and the largest ratio of the exact probability to the Chebyshev bound where that bound
+    is below 1 (``cheb_bound_ratio``, None where it is nowhere below 1) (LQG-3); the weighted
+    average with its CI and its limit J(σ²/2) (LQG-4); the linear-cost check (LIN-1, None
+    without one)."""
+
+    j: str
+    j_nbo: str
+    var_g: str
+    slope: str
+    slope_ci: str
+    rmse: str
+    p: int
+    nbo_error: str
+    nbo_error_in_rmse: str
+    nbo_max_z: str
+    nbo_checks: int
+    cheb_cells: int
+    cheb_departing: int
+    cheb_min_p: str
+    cheb_bound_ratio: str | None
+    weighted: str
+    weighted_limit: str
+    linear: LinearText | None
+
+
+def _results(
     summary: pd.DataFrame,
     nbo: pd.DataFrame,
     conv: pd.DataFrame,
     eps_values: Sequence[float],
     claims: Mapping[str, Claim],
-) -> str:
+) -> ResultsText:
     """Closed forms, the RMSE slope (LQG-2), the NBO-error check (LQG-1), the Chebyshev
-    cells (LQG-3) and the weighted estimate (LQG-4)."""
+    cells (LQG-3), the weighted estimate (LQG-4) and the linear-cost check (LIN-1)."""
     u, model = model_from_table(conv)
     last = summary.iloc[-1]
     var_g = lqg.cost_variance(u, **model.closed_form_args())
     nbo_err = float(last["J_exact"] - last["J_nbo"])
     fit = fig3_check(summary).fit
     sd = ci_digits(fit.low, fit.high)
-    j_text = fmt_exact(last["J_exact"], 4)
-    c1, c4 = claims["LQG-1"], claims["LQG-4"]
+    test = chebyshev_check(summary, eps_values).test
+    c1, c4, lin = claims["LQG-1"], claims["LQG-4"], claims.get("LIN-1")
     kd = c4.key.digits
-    weighted = f"{fmt(c4.key.value, kd)} {fmt_ci(c4.key.ci_low, c4.key.ci_high, kd)}"
-    return (
-        f"Closed forms: J = {j_text}, J_NBO = {fmt_exact(last['J_nbo'], 4)}, "
-        f"Var(g) = {fmt_exact(var_g, 4)}. The root-mean-square error (RMSE) of J_P scales like "
-        f"P^{fmt(fit.slope, sd)} {fmt_ci(fit.low, fit.high, sd)} (theory "
-        f"-1/2) and is {fmt(last['rmse'], 3)} at P = {int(last['P'])}, where NBO's error "
-        f"J - J_NBO = r σ² Σ_{{n<H}} (1-a)^{{2n}} = {fmt_exact(nbo_err, 4)} is "
-        f"{fmt(abs(nbo_err) / float(last['rmse']), 2)} times the RMSE (LQG-2). Simulated and "
-        f"closed-form NBO errors differ by at most {fmt(c1.key.value, 3)} standard errors "
-        f"over {len(nbo) + 1} checks (Bonferroni limit {fmt(nbo_z_limit(len(nbo)), 3)}; "
-        f"LQG-1). {_chebyshev_sentence(summary, eps_values, claims['LQG-3'])} (LQG-3). "
-        f"The likeliness-weighted average is {weighted} at P = {int(last['P'])} (J = "
-        f"{j_text}); J(σ²/2) = {fmt_exact(last['weighted_limit'], kd)} is its limit, since "
-        "the weights tilt the noise to N(0, σ²/2); Prop. 2's proof needs weights monotone in "
-        "the sample index, which likeliness weights are not (LQG-4)."
-        + _linear_sentence(claims.get("LIN-1"))
+    return ResultsText(
+        j=fmt_exact(last["J_exact"], 4),
+        j_nbo=fmt_exact(last["J_nbo"], 4),
+        var_g=fmt_exact(var_g, 4),
+        slope=fmt(fit.slope, sd),
+        slope_ci=fmt_ci(fit.low, fit.high, sd),
+        rmse=fmt(last["rmse"], 3),
+        p=int(last["P"]),
+        nbo_error=fmt_exact(nbo_err, 4),
+        nbo_error_in_rmse=fmt(abs(nbo_err) / float(last["rmse"]), 2),
+        nbo_max_z=fmt(c1.key.value, 3),
+        nbo_checks=len(nbo) + 1,
+        cheb_cells=test.cells,
+        cheb_departing=test.departing,
+        cheb_min_p=fmt(test.min_p, 3),
+        cheb_bound_ratio=(
+            fmt(test.max_exact_ratio, 2) if np.isfinite(test.max_exact_ratio) else None
+        ),
+        weighted=f"{fmt(c4.key.value, kd)} {fmt_ci(c4.key.ci_low, c4.key.ci_high, kd)}",
+        weighted_limit=fmt_exact(last["weighted_limit"], kd),
+        linear=(
+            None
+            if lin is None
+            else LinearText(name=lin.key.name, value=fmt(lin.key.value, 3), verdict=lin.verdict)
+        ),
     )
 
 
-def _figures_text(summary: pd.DataFrame, nbo: pd.DataFrame) -> list[str]:
-    """The four figures with their captions (main text)."""
-    reps = int(summary.iloc[-1]["n_replicates"])
-    n_clip = int((nbo["z"].abs() > NBO_Z_CLIP).sum())
-    clipped = f" ({n_clip} beyond ±{fmt(NBO_Z_CLIP, 1)} drawn at the panel edge)" if n_clip else ""
-    return [
-        "![Fig. 3, paper style](figures/lqg_fig3_paper.png)",
-        "",
-        f"*Paper-style Fig. 3: one realisation of J_P for each P ({_p_text(summary)}); NBO "
-        "and exact J as lines.*",
-        "",
-        "![J_P vs P, statistics](figures/lqg_convergence.png)",
-        "",
-        f"*Our view of Fig. 3: mean of J_P over {reps} replicates with its 95% CI and the "
-        "central 95% of replicates; right, mean − J.*",
-        "",
-        "![error vs P](figures/lqg_error_loglog.png)",
-        "",
-        "*RMSE vs P with √(Var(g)/P); observed P(|J_P − J| ≥ ε) vs the Chebyshev bound "
-        "(frequency 0 drawn at the floor).*",
-        "",
-        "![NBO error](figures/lqg_nbo_error.png)",
-        "",
-        "*NBO error vs H per a, simulated (95% CI) vs closed form; below, the difference in "
-        f"standard errors with the Bonferroni limits of LQG-1{clipped}.*",
-    ]
+def _body(
+    summary: pd.DataFrame,
+    nbo: pd.DataFrame,
+    conv: pd.DataFrame,
+    eps_values: Sequence[float],
+    claims: Mapping[str, Claim],
+) -> str:
+    """The main text (``section.md``): the model, the paper's setting and what we ran; the
+    results; the four figures with their captions."""
+    return _render(
+        "section.md",
+        model=ModelText.of(conv),
+        nbo_run=NboRunText.of(nbo),
+        p_text=_p_text(summary),
+        replicates=int(summary.iloc[-1]["n_replicates"]),
+        results=_results(summary, nbo, conv, eps_values, claims),
+        z_clipped=int((nbo["z"].abs() > NBO_Z_CLIP).sum()),
+        z_clip=fmt(NBO_Z_CLIP, 1),
+    )
 
 
 def _appendix(conv: pd.DataFrame, nbo: pd.DataFrame, tables: Mapping[str, str]) -> str:
-    """Model constants, the weighted-estimator derivation and the four tables."""
-    u, model = model_from_table(conv)
-    reps, p_nbo = int(nbo["n_replicates"].iloc[0]), int(nbo["P"].iloc[0])
-    return "\n".join(
-        [
-            f"Model constants of the convergence run: a = {eps_label(model.a)}, x_0 = "
-            f"{eps_label(model.x0)}, r = {eps_label(model.r)}, T = {eps_label(model.target)}, "
-            f"σ = {eps_label(model.sigma)}, u = ({', '.join(eps_label(v) for v in u)}). Every "
-            "(P, replicate) draws its own P × H noise (no nesting across P), so the replicates "
-            "and the values of P are independent. Full per-P table: `results/lqg/summary.csv`.",
-            "",
-            "**Weighted estimator.** It weights trajectory i by q_i ∝ Π_k φ(w_k^i; 0, σ²). "
-            "Under sampling from N(0, σ²) the weighted average converges to E[q g]/E[q], the "
-            "expectation under the density ∝ φ², i.e. N(0, σ²/2): the limit is J(σ²/2) = "
-            "J - r Var(x_H)/2. Prop. 2 borrows a result on weighted averages with weights "
-            "monotonically decreasing in the sample index; sorting the samples by likeliness "
-            "makes the order depend on the samples, so the result does not apply.",
-            "",
-            "Convergence of J_P (subset of P, log-spaced):",
-            "",
-            tables["lqg_convergence"],
-            "",
-            f"NBO error J - J_NBO per a (rows) and H (columns): simulated mean ± 95% half-width "
-            f"(closed form), {reps} replicates of P = {p_nbo}, "
-            f"u_k = {eps_label(nbo['u_value'].iloc[0])}:",
-            "",
-            tables["lqg_nbo_error"],
-            "",
-            f"z = (simulated - closed form)/SE of the same cells (LQG-1 limit ± "
-            f"{fmt(nbo_z_limit(len(nbo)), 3)}):",
-            "",
-            tables["lqg_nbo_z"],
-            "",
-            "Chebyshev bound Var(g)/(Pε²) (vacuous where ≥ 1) vs the observed exceedances of "
-            "|J_P - J| ≥ ε with Clopper-Pearson (CP) 95% limits (subset of P):",
-            "",
-            tables["lqg_chebyshev"],
-        ]
+    """Model constants, the weighted-estimator derivation and the four tables
+    (``appendix.md``)."""
+    return _render(
+        "appendix.md",
+        model=ModelText.of(conv),
+        nbo_run=NboRunText.of(nbo),
+        tables={stem: tables[stem] for stem in TABLES},
     )
 
 
@@ -309,20 +349,11 @@ def lqg_section(
     check of Prop. 3 on a linear-cost system (claim LIN-1)."""
     claims = lqg_claims(summary, nbo, conv, eps_values, linear)
     by_id = {c.id: c for c in claims}
-    body = "\n".join(
-        [
-            _setting_paragraph(summary, nbo, conv),
-            "",
-            _results_paragraph(summary, nbo, conv, eps_values, by_id),
-            "",
-            *_figures_text(summary, nbo),
-        ]
-    )
     return Section(
         key="lqg",
         title="Case study 1: scalar LQG (paper Sec. III-A, Fig. 3)",
         order=10,
-        body=body,
+        body=_body(summary, nbo, conv, eps_values, by_id),
         claims=claims,
         figures=[f"{f}.png" for f in FIGURES],
         appendix=_appendix(conv, nbo, tables),
