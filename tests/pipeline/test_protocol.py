@@ -405,7 +405,7 @@ def test_confirm_figure_plots_the_cost_the_budget_counts():
 
 def test_confirm_section_reads_its_numbers_from_the_tables():
     from rsmhp.studies.frontier.claims import confirm_claims
-    from rsmhp.studies.frontier.section import confirm_section, confirm_tables
+    from rsmhp.studies.frontier.section import ConfirmInputs, confirm_section, confirm_tables
     from rsmhp.studies.frontier.summarise import ladder, summarize_configs
 
     runs, timing, chosen = _confirm_tables()
@@ -414,17 +414,15 @@ def test_confirm_section_reads_its_numbers_from_the_tables():
     claims = confirm_claims(runs, s, lad, PREREG, chosen, "f" * 64)
     tuned = {"provenance": {"candidates": 7, "runs per candidate": 4}, "chosen": {}}
     tables = confirm_tables(s, lad, tuned)
-    sec = confirm_section(s, lad, claims, tables, {**PREREG, "power_text": "p"},
-                          {"path": "p.yaml", "sha256": "f" * 64, "commit": "c" * 40}, tuned,
-                          [{"id": "FR-1-x", "key": {"value": 1.0, "ci_low": 0.5,
-                                                    "ci_high": 1.5, "unit": "m"},
-                            "verdict": "supported"}],
-                          superseded={"what": "budgeted on medians.",
-                                      "preregistration": {"sha256": "e" * 64,
-                                                          "commit": "d" * 40},
-                                      "claims": [{"id": "FR-2-y",
-                                                  "key": {"value": 2.0, "unit": "m"},
-                                                  "verdict": "inconclusive"}]})  # fmt: skip
+    sec = confirm_section(ConfirmInputs(
+        s, lad, claims, tables, {**PREREG, "power_text": "p"},
+        {"path": "p.yaml", "sha256": "f" * 64, "commit": "c" * 40}, tuned,
+        [{"id": "FR-1-x", "key": {"value": 1.0, "ci_low": 0.5, "ci_high": 1.5, "unit": "m"},
+          "verdict": "supported"}],
+        superseded={"what": "budgeted on medians.",
+                    "preregistration": {"sha256": "e" * 64, "commit": "d" * 40},
+                    "claims": [{"id": "FR-2-y", "key": {"value": 2.0, "unit": "m"},
+                                "verdict": "inconclusive"}]}))  # fmt: skip
     assert sec.key == "decisions_frontier" and len(sec.claims) == 3
     assert "sha256 eeeeeeeeeeee, commit dddddddddd; superseded, not counted" in sec.appendix
     assert "FR-2-y" in sec.appendix and "budgeted on medians." in sec.appendix

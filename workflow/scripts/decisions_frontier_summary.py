@@ -9,7 +9,7 @@ import pandas as pd
 from rsmhp.pipeline.contracts import read_checked
 from rsmhp.pipeline.io import write_csv, write_text
 from rsmhp.pipeline.script import rule_logging
-from rsmhp.studies.frontier.section import frontier_section, frontier_tables
+from rsmhp.studies.frontier.section import FrontierInputs, frontier_section, frontier_tables
 from rsmhp.studies.frontier.simulate import frontier_contracts, timing_contract
 from rsmhp.studies.frontier.summarise import summarize_frontier
 
@@ -32,7 +32,9 @@ with rule_logging(snakemake) as log:
     timing = pd.concat(timing, ignore_index=True)
     summary = summarize_frontier(runs, regret, timing)
     tables = frontier_tables(summary, p.cfg)
-    section = frontier_section(runs, regret, summary, tables, p.cfg, p.seed, p.horizon)
+    section = frontier_section(
+        FrontierInputs(runs, regret, summary, tables, p.cfg, p.seed, p.horizon)
+    )
     write_csv(summary, snakemake.output.summary)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)

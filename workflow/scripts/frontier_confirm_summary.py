@@ -10,7 +10,7 @@ from rsmhp.pipeline.io import write_csv, write_text
 from rsmhp.pipeline.protocol import Configuration, file_commit, tuned_configurations
 from rsmhp.pipeline.script import rule_logging
 from rsmhp.studies.frontier.claims import confirm_claims
-from rsmhp.studies.frontier.section import confirm_section, confirm_tables
+from rsmhp.studies.frontier.section import ConfirmInputs, confirm_section, confirm_tables
 from rsmhp.studies.frontier.simulate import config_runs_contract, config_timing_contract
 from rsmhp.studies.frontier.summarise import ladder, summarize_configs
 
@@ -45,15 +45,17 @@ with rule_logging(snakemake) as log:
     commit = file_commit(Path(snakemake.scriptdir).resolve().parents[1] / c["path"])
     meta = {"path": c["path"], "sha256": c["sha256"], "commit": commit}
     section = confirm_section(
-        summary,
-        lad,
-        claims,
-        tables,
-        pre,
-        meta,
-        c["tuned"],
-        exploratory,
-        superseded=snakemake.params.superseded,
+        ConfirmInputs(
+            summary=summary,
+            lad=lad,
+            claims=claims,
+            tables=tables,
+            prereg=pre,
+            prereg_meta=meta,
+            tuned=c["tuned"],
+            exploratory=exploratory,
+            superseded=snakemake.params.superseded,
+        )
     )
     write_csv(summary, snakemake.output.summary)
     write_csv(lad, snakemake.output.ladder)

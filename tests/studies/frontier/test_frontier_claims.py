@@ -237,14 +237,14 @@ def test_missing_members_drop_their_claims_only():
 
 
 def test_exploratory_section_states_every_comparison_and_the_budget():
-    from rsmhp.studies.frontier.section import frontier_section, frontier_tables
+    from rsmhp.studies.frontier.section import FrontierInputs, frontier_section, frontier_tables
 
     runs, regret = _tables()
     summary = summarize_frontier(runs, regret)
     cfg = {**_cfg(), "runs": N_RUNS, "regret_runs": 2, "regret_steps": [0, 1, 2, 3, 4],
            "track_loss_error": 50.0}  # fmt: skip
     tables = frontier_tables(summary, cfg)
-    sec = frontier_section(runs, regret, summary, tables, cfg, seed=11, horizon=6)
+    sec = frontier_section(FrontierInputs(runs, regret, summary, tables, cfg, seed=11, horizon=6))
     # the exploratory design: its comparisons are printed, never claims of the ledger
     assert sec.key == "decisions_frontier_exploratory" and sec.claims == []
     assert "Exploratory comparisons (not claims)" in sec.body

@@ -1,11 +1,15 @@
 """Equal-compute study of the planners, report section (order 32): the Markdown tables of the
 frontier and of the budget check, a short body (setting, findings, figure) and the appendix,
 assembled from :mod:`rsmhp.studies.frontier.summarise` and the claims of
-:mod:`rsmhp.studies.frontier.claims`. Every number is read from the tables or the claims."""
+:mod:`rsmhp.studies.frontier.claims`; likewise the confirmatory section of the protocol (order
+32). Every number is read from the tables or the claims. The prose is in the templates beside
+this module (``section.md`` and ``appendix.md``: the exploratory design; ``confirm.md`` and
+``confirm_appendix.md``: the confirmatory run), filled with the values computed here."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import pandas as pd
@@ -15,11 +19,22 @@ from rsmhp.models.uav.methods.tree_search import ALPHA_A, ALPHA_O, C_UCB, K_A, K
 from rsmhp.report.ledger import Claim, Section
 from rsmhp.report.markdown import ci_cells, fmt, fmt_ci, markdown_table, param_text
 from rsmhp.report.palette import method_label
+from rsmhp.report.templates import render
 from rsmhp.studies.frontier.claims import frontier_claims
 from rsmhp.studies.frontier.figures import FIGURES
 from rsmhp.studies.frontier.summarise import budget_check
 
-__all__ = ["FIGURES", "TABLES", "frontier_section", "frontier_tables"]
+__all__ = [
+    "CONFIRM_TABLES",
+    "FIGURES",
+    "TABLES",
+    "ConfirmInputs",
+    "FrontierInputs",
+    "confirm_section",
+    "confirm_tables",
+    "frontier_section",
+    "frontier_tables",
+]
 
 #: table stems of the section (the summary rule writes them; see frontier.smk)
 TABLES = ("dec_frontier", "dec_frontier_budget")
@@ -88,23 +103,67 @@ def frontier_tables(summary: pd.DataFrame, cfg: Mapping[str, Any]) -> dict[str, 
     }
 
 
-def _setting(cfg: Mapping[str, Any], summary: pd.DataFrame) -> str:
-    members = [method_label(m) for m in cfg["budget"]["members"]]
-    fams = list(dict.fromkeys(summary["family"]))
-    labels = {c.family: c.family_label for c in registry.families()}
-    return (
-        f"Every planner family ({', '.join(labels.get(f, f) for f in fams)}) at several sizes "
-        f"on {', '.join(repr(m) for m in cfg['models'])}: {int(cfg['runs'])} paired "
-        "closed-loop runs per method, the planning milliseconds per step measured in the same "
-        "one-thread job (median over runs), and the open-loop relative regret at the belief "
-        f"states of {int(cfg['regret_runs'])} NBO runs, scored as in the decision study "
-        "(methods: README, 'Planning methods'; the tree search is PFT-DPW over Kalman "
-        "beliefs). Claims FR-1..3 compare one member per family at the **planning budget** "
-        f"of {param_text(float(cfg['budget']['ms_per_step']))} ms per step: "
-        f"{', '.join(members)} (fixed in the config as the largest members within the "
-        "budget in a first run of the study; checked against this run's times in the "
-        "appendix)."
-    )
+def _render(template: str, **values: Any) -> str:
+    """``template`` (a file beside this module) filled with ``values``, without the newline
+    that ends the file."""
+    return render(__package__, template, **values).removesuffix("\n")
+
+
+def _family_labels() -> dict[str, str]:
+    return {c.family: c.family_label for c in registry.families()}
+
+
+@dataclass(frozen=True)
+class FrontierInputs:
+    """What the exploratory section is built from: the closed-loop ``runs``, the open-loop
+    ``regret``, their ``summary`` (:func:`rsmhp.studies.frontier.summarise.summarize_frontier`),
+    the Markdown ``tables`` (:func:`frontier_tables`), ``cfg`` = ``decisions.frontier``, the
+    root ``seed`` and ``horizon`` = the planners' H (``uav.planner.horizon``)."""
+
+    runs: pd.DataFrame
+    regret: pd.DataFrame
+    summary: pd.DataFrame
+    tables: Mapping[str, str]
+    cfg: Mapping[str, Any]
+    seed: int
+    horizon: int
+
+
+@dataclass(frozen=True)
+class ClaimResult:
+    """One comparison's key number as printed: ``'<name>' <value> <ci> (<verdict>)``."""
+
+    name: str
+    value: str
+    ci: str
+    verdict: str
+
+
+@dataclass(frozen=True)
+class Comparison:
+    """The comparisons of one claim family (``FR-1``): what it compares and every result."""
+
+    claims: str
+    compared: str
+    results: list[ClaimResult]
+
+
+@dataclass(frozen=True)
+class ClosedLoop:
+    """One model's closed-loop tally against NBO: members with the CI of their paired
+    difference below 0 (``better``) or above 0 (``worse``) out of ``members``, per family
+    (``"RS-MHP 3/3, sigma points 1/1"``, empty when none), and the planning ms per step."""
+
+    model: str
+    runs: int
+    members: int
+    better: int
+    better_families: str
+    worse: int
+    worse_families: str
+    nbo_ms: str
+    fastest_ms: str
+    slowest_ms: str
 
 
 #: (claim id prefix, what it compares) of the findings paragraph
@@ -117,128 +176,106 @@ _COMPARED = (
 
 def _per_family(rows: pd.DataFrame, of: pd.DataFrame) -> str:
     """``RS-MHP 3/3, sigma points 1/1``: members of ``rows`` per family, of those in ``of``."""
-    labels = {c.family: c.family_label for c in registry.families()}
+    labels = _family_labels()
     return ", ".join(
         f"{labels.get(f, f)} {int((rows['family'] == f).sum())}/{int((of['family'] == f).sum())}"
         for f in dict.fromkeys(rows["family"])
     )
 
 
-def _findings(claims: Sequence[Claim], summary: pd.DataFrame) -> str:
+def _comparisons(claims: Sequence[Claim]) -> list[Comparison]:
     out = []
-    for prefix, lead in _COMPARED:
+    for prefix, compared in _COMPARED:
         sel = [c for c in claims if c.id.startswith(prefix)]
-        if not sel:
-            continue
-        parts = []
-        for c in sel:
-            k, unit = c.key, " m" if c.key.unit == "m" else " pp"
-            parts.append(
-                f"'{c.id[len(prefix) :]}' {fmt(k.value, k.digits, True)}{unit} "
-                f"{fmt_ci(k.ci_low, k.ci_high, k.digits, True)} ({c.verdict})"
-            )
-        out.append(f"{prefix[:-1]} ({lead} at the budget): " + "; ".join(parts) + ".")
+        if sel:
+            results = [
+                ClaimResult(
+                    name=c.id[len(prefix) :],
+                    value=fmt(c.key.value, c.key.digits, True)
+                    + (" m" if c.key.unit == "m" else " pp"),
+                    ci=fmt_ci(c.key.ci_low, c.key.ci_high, c.key.digits, True),
+                    verdict=c.verdict,
+                )
+                for c in sel
+            ]
+            out.append(Comparison(prefix[:-1], compared, results))
+    return out
+
+
+def _closed_loop(summary: pd.DataFrame) -> list[ClosedLoop]:
     base = registry.baseline()().name
+    out = []
     for model, s in summary.groupby("model", sort=False):
         others = s[s["method"] != base].dropna(subset=["error_diff_high"])
         better = others[others["error_diff_high"] < 0]
         worse = others[others["error_diff_low"] > 0]
         out.append(
-            f"Closed loop against NBO on '{model}' ({int(s['runs'].iloc[0])} paired runs): "
-            f"{len(better)} of {len(others)} members better (CI below 0"
-            + (f": {_per_family(better, others)}" if len(better) else "")
-            + f"), {len(worse)} worse"
-            + (f" ({_per_family(worse, others)})" if len(worse) else "")
-            + f"; NBO plans in {fmt(float(s.loc[s['method'] == base, 'plan_ms'].iloc[0]), 2)} "
-            f"ms per step, the others in {fmt(float(others['plan_ms'].min()), 2)} to "
-            f"{fmt(float(others['plan_ms'].max()), 2)} ms."
+            ClosedLoop(
+                model=str(model),
+                runs=int(s["runs"].iloc[0]),
+                members=len(others),
+                better=len(better),
+                better_families=_per_family(better, others),
+                worse=len(worse),
+                worse_families=_per_family(worse, others),
+                nbo_ms=fmt(float(s.loc[s["method"] == base, "plan_ms"].iloc[0]), 2),
+                fastest_ms=fmt(float(others["plan_ms"].min()), 2),
+                slowest_ms=fmt(float(others["plan_ms"].max()), 2),
+            )
         )
-    return " ".join(out)
+    return out
 
 
-_FIGURE = [
-    "![Planner frontier](figures/dec_frontier.png)",
-    "",
-    "*Decision quality against planning milliseconds per step (log scale), one line per "
-    "family through its members; top: open-loop relative regret − NBO's (pp), bottom: "
-    "closed-loop mean location error − NBO's (m), below 0 better than NBO; bars: 95% "
-    "bootstrap CIs; dotted: the planning budget of FR-1..3.*",
-]
-
-
-def _appendix(cfg: Mapping[str, Any], tables: Mapping[str, str], horizon: int) -> str:
-    return "\n".join(
-        [
-            "Per model and method: planning ms per step (median over runs, one thread, "
-            "measured on this machine: the one column of this study that differs across "
-            "machines and reruns), mean location error over runs and its paired difference "
-            f"with NBO, track loss (final error above {param_text(cfg['track_loss_error'])} "
-            "m), open-loop relative regret (%) and its paired difference with NBO at the same "
-            "belief states (pp); CIs: 95% percentile bootstrap over runs or states "
-            f"({int(cfg['bootstrap'])} resamples).",
-            "",
-            tables["dec_frontier"],
-            "",
-            f"Budget members against the budget of "
-            f"{param_text(float(cfg['budget']['ms_per_step']))} ms per step on this run's "
-            "times (a member over the budget, or a larger member within it, is named as "
-            "contrary evidence of the claims that use it):",
-            "",
-            tables["dec_frontier_budget"],
-            "",
-            f"Methods: **RQMC**, scrambled Sobol' points through the normal quantile, a fresh "
-            "scramble per planning step; **antithetic**, pairs (w, −w); **sigma points**, the "
-            f"{8 * (horizon + 1)} equally weighted cubature points ±√n e_i of the joint "
-            f"Gaussian of the target belief and the {horizon} steps of process noise (n = "
-            f"{4 * (horizon + 1)}); **tree search**, PFT-DPW over Kalman beliefs (a belief "
-            "node's children are sampled controls, its observation children sampled "
-            "measurements, both widened progressively; reward −tr P), with a budget in "
-            "simulations per planning step. "
-            "Tree search constants (`rsmhp.models.uav.methods.tree_search`, chosen before "
-            f"any run): "
-            f"UCB exploration c = {C_UCB} on per-step rewards −tr P / tr P̂ of the root, action "
-            f"widening k_a = {K_A:g}, α_a = {ALPHA_A}, observation widening k_o = {K_O:g}, "
-            f"α_o = {ALPHA_O} (members may set their own: `_ka`, `_ko`, `_ao`, `_c` in the "
-            "name); the first action at each depth is the warm start's, the second the "
-            "pursuit policy's (steer to the estimate, close the range); rollouts and the plan "
-            "beyond the most visited path follow the pursuit policy.",
-        ]
+def _body(inputs: FrontierInputs, claims: Sequence[Claim]) -> str:
+    cfg, summary = inputs.cfg, inputs.summary
+    labels = _family_labels()
+    return _render(
+        "section.md",
+        families=", ".join(labels.get(f, f) for f in dict.fromkeys(summary["family"])),
+        models=", ".join(repr(m) for m in cfg["models"]),
+        runs=int(cfg["runs"]),
+        regret_runs=int(cfg["regret_runs"]),
+        budget_ms=param_text(float(cfg["budget"]["ms_per_step"])),
+        members=", ".join(method_label(m) for m in cfg["budget"]["members"]),
+        comparisons=_comparisons(claims),
+        closed_loop=_closed_loop(summary),
     )
 
 
-def frontier_section(
-    runs: pd.DataFrame,
-    regret: pd.DataFrame,
-    summary: pd.DataFrame,
-    tables: Mapping[str, str],
-    cfg: Mapping[str, Any],
-    seed: int,
-    horizon: int,
-) -> Section:
+def _appendix(inputs: FrontierInputs) -> str:
+    cfg, horizon = inputs.cfg, inputs.horizon
+    return _render(
+        "appendix.md",
+        track_loss_error=param_text(cfg["track_loss_error"]),
+        bootstrap=int(cfg["bootstrap"]),
+        frontier_table=inputs.tables["dec_frontier"],
+        budget_ms=param_text(float(cfg["budget"]["ms_per_step"])),
+        budget_table=inputs.tables["dec_frontier_budget"],
+        sigma_points=8 * (horizon + 1),
+        horizon=horizon,
+        dimension=4 * (horizon + 1),
+        c_ucb=str(C_UCB),
+        k_a=f"{K_A:g}",
+        alpha_a=str(ALPHA_A),
+        k_o=f"{K_O:g}",
+        alpha_o=str(ALPHA_O),
+    )
+
+
+def frontier_section(inputs: FrontierInputs) -> Section:
     """The exploratory equal-compute design's report section (order 33, only with
-    ``decisions.frontier.exploratory``); ``cfg`` is ``decisions.frontier``, ``horizon`` the
-    planners' H (``uav.planner.horizon``). Its comparisons FR-1..3 were chosen on the data
+    ``decisions.frontier.exploratory``). Its comparisons FR-1..3 were chosen on the data
     that judge them: they are printed as exploratory findings, never as claims of the
     ledger (the ledger's FR claims come from the confirmatory run)."""
-    claims = frontier_claims(runs, regret, summary, cfg, seed)
-    body = "\n".join(
-        [
-            "**Exploratory design** (published up to 76a0c01; its comparisons were chosen on "
-            "the data that judge them, so nothing here is counted). " + _setting(cfg, summary),
-            "",
-            "Exploratory comparisons (not claims): " + _findings(claims, summary),
-            "",
-            *_FIGURE,
-        ]
-    )
+    claims = frontier_claims(inputs.runs, inputs.regret, inputs.summary, inputs.cfg, inputs.seed)
     return Section(
         key="decisions_frontier_exploratory",
         title="Planners at equal compute: the exploratory design",
         order=33,
-        body=body,
+        body=_body(inputs, claims),
         claims=[],
         figures=list(FIGURES),
-        appendix=_appendix(cfg, tables, horizon),
+        appendix=_appendix(inputs),
     )
 
 
@@ -337,30 +374,140 @@ def confirm_tables(
     }
 
 
-def _best_per_budget(lad: pd.DataFrame) -> str:
-    labels = {c.family: c.family_label for c in registry.families()}
+@dataclass(frozen=True)
+class ConfirmInputs:
+    """What the confirmatory section is built from: the per-configuration ``summary``
+    (:func:`rsmhp.studies.frontier.summarise.summarize_configs`), the ladder ``lad``
+    (:func:`rsmhp.studies.frontier.summarise.ladder`), the FR ``claims``, the Markdown
+    ``tables`` (:func:`confirm_tables`), ``prereg`` the preregistration's content and
+    ``prereg_meta`` its ``path``, ``sha256`` and ``commit``, ``tuned`` the tuned file,
+    ``exploratory`` the FR and HZ claims published at 76a0c01 (kept, not counted) and
+    ``superseded`` an earlier confirmatory run's record (``what``, ``preregistration``,
+    ``claims``: kept, not counted), if any."""
+
+    summary: pd.DataFrame
+    lad: pd.DataFrame
+    claims: Sequence[Claim]
+    tables: Mapping[str, str]
+    prereg: Mapping[str, Any]
+    prereg_meta: Mapping[str, str]
+    tuned: Mapping[str, Any]
+    exploratory: Sequence[Mapping[str, Any]]
+    superseded: Mapping[str, Any] | None = None
+
+
+@dataclass(frozen=True)
+class Tuning:
+    """The tuning run as the setting names it (its ``provenance`` in the tuned file; ``?``
+    where the file lacks an entry)."""
+
+    candidates: str
+    runs_per_candidate: str
+    date: str
+    commit: str
+
+
+@dataclass(frozen=True)
+class RunCount:
+    """The preregistered number of confirmatory runs on one model."""
+
+    model: str
+    runs: str
+
+
+@dataclass(frozen=True)
+class Preregistration:
+    """The preregistration as the setting names it: file, hashes, budgets, run counts."""
+
+    path: str
+    sha256: str
+    commit: str
+    budgets_ms: str
+    headline_ms: str
+    runs: list[RunCount]
+    power_text: str
+    stream: str
+
+
+@dataclass(frozen=True)
+class ConfirmedClaim:
+    """One preregistered claim's key number (m) before Holm's correction."""
+
+    id: str
+    value: str
+    ci: str
+    verdict: str
+
+
+@dataclass(frozen=True)
+class Spent:
+    """What the members at the claims' budget spent on one model in closed loop: ``spent``
+    (``"RS-MHP 1.9, RQMC 2.1"``, ms per step) and the families over the budget (``over``,
+    empty when all are within it)."""
+
+    model: str
+    spent: str
+    over: str
+
+
+@dataclass(frozen=True)
+class Rung:
+    """One budget of a model: the family with the lowest mean error, and the families whose
+    difference with Monte Carlo has its CI below 0 (``below``, empty when none)."""
+
+    budget_ms: str
+    family: str
+    error: str
+    below: str
+
+
+@dataclass(frozen=True)
+class BestPerBudget:
+    """The rungs of one model's ladder."""
+
+    model: str
+    rungs: list[Rung]
+
+
+@dataclass(frozen=True)
+class TreeDepths:
+    """The tuned tree searches' depth statistics (ranges over configurations)."""
+
+    configurations: int
+    plan_depth_min: str
+    plan_depth_max: str
+    max_depth_min: str
+    max_depth_max: str
+
+
+@dataclass(frozen=True)
+class Superseded:
+    """An earlier confirmatory run: its preregistration, what changed, its claims' table."""
+
+    sha256: str
+    commit: str
+    what: str
+    table: str
+
+
+def _best_per_budget(lad: pd.DataFrame) -> list[BestPerBudget]:
+    labels = _family_labels()
     out = []
     for model, g in lad.groupby("model", sort=False):
-        parts = []
+        rungs = []
         for b, f in g.groupby("budget_ms", sort=True):
             best = f.loc[f["mean_error"].idxmin()]
             clear = f[(f["diff_mc_high"] < 0)]
-            parts.append(
-                f"{param_text(float(b))} ms: {labels.get(best['family'], best['family'])} "
-                f"({fmt(float(best['mean_error']), 3)} m"
-                + (
-                    f"; below Monte Carlo's CI-wise: "
-                    f"{', '.join(labels.get(x, x) for x in clear['family'])})"
-                    if len(clear)
-                    else "; no family below Monte Carlo CI-wise)"
+            rungs.append(
+                Rung(
+                    budget_ms=param_text(float(b)),
+                    family=labels.get(best["family"], best["family"]),
+                    error=fmt(float(best["mean_error"]), 3),
+                    below=", ".join(labels.get(x, x) for x in clear["family"]),
                 )
             )
-        out.append(f"'{model}': " + "; ".join(parts))
-    return (
-        "Lowest mean closed-loop error per budget (descriptive, not a claim): "
-        + ". ".join(out)
-        + "."
-    )
+        out.append(BestPerBudget(str(model), rungs))
+    return out
 
 
 def _exploratory_table(exploratory: Sequence[Mapping[str, Any]]) -> str:
@@ -384,172 +531,113 @@ def _exploratory_table(exploratory: Sequence[Mapping[str, Any]]) -> str:
     return markdown_table(t)
 
 
-def _headline_compute(lad: pd.DataFrame, budget: float) -> str:
+def _headline_compute(lad: pd.DataFrame, budget: float) -> list[Spent]:
     """What the members at the claims' budget spent in this run's closed loop (ms per step,
     the mean over runs), and which of them went over the budget on the tuning rule's cost."""
-    at = lad[lad["budget_ms"] == budget]
-    if at.empty:
-        return ""
-    labels = {c.family: c.family_label for c in registry.families()}
-    parts = []
-    for model, g in at.groupby("model", sort=False):
-        spent = ", ".join(
-            f"{labels.get(r.family, r.family)} {fmt(float(r.loop_ms), 3)}" for r in g.itertuples()
-        )
-        over = [labels.get(r.family, r.family) for r in g.itertuples() if not r.within_budget]
-        parts.append(
-            f"'{model}': {spent}"
-            + (f" (over the budget here: {', '.join(over)})" if over else " (all within it)")
-        )
-    return (
-        f"Closed-loop ms per step at {param_text(budget)} ms (mean over runs): {'; '.join(parts)}. "
-    )
-
-
-def _superseded_text(sup: Mapping[str, Any]) -> list[str]:
-    pre = sup.get("preregistration", {})
+    labels = _family_labels()
     return [
-        "",
-        f"An earlier confirmatory run (preregistration sha256 {str(pre.get('sha256', '?'))[:12]}, "
-        f"commit {str(pre.get('commit', '?'))[:10]}; superseded, not counted): "
-        f"{sup.get('what', '')}",
-        "",
-        _exploratory_table(sup.get("claims", [])),
+        Spent(
+            model=str(model),
+            spent=", ".join(
+                f"{labels.get(r.family, r.family)} {fmt(float(r.loop_ms), 3)}"
+                for r in g.itertuples()
+            ),
+            over=", ".join(
+                labels.get(r.family, r.family) for r in g.itertuples() if not r.within_budget
+            ),
+        )
+        for model, g in lad[lad["budget_ms"] == budget].groupby("model", sort=False)
     ]
 
 
-def confirm_section(
-    summary: pd.DataFrame,
-    lad: pd.DataFrame,
-    claims: Sequence[Claim],
-    tables: Mapping[str, str],
-    prereg: Mapping[str, Any],
-    prereg_meta: Mapping[str, str],
-    tuned: Mapping[str, Any],
-    exploratory: Sequence[Mapping[str, Any]],
-    superseded: Mapping[str, Any] | None = None,
-) -> Section:
-    """The equal-compute study's report section (order 32) from the confirmatory run of the
-    protocol (:mod:`rsmhp.pipeline.protocol`): ``prereg`` the preregistration's content and
-    ``prereg_meta`` its path, sha256 and commit; ``tuned`` the tuned file; ``exploratory``
-    the FR and HZ claims published at 76a0c01 (kept, not counted); ``superseded`` an earlier
-    confirmatory run's record (``what``, ``preregistration``, ``claims``: kept, not
-    counted)."""
+def _tuning(tuned: Mapping[str, Any]) -> Tuning:
     prov = tuned.get("provenance", {})
+    return Tuning(
+        candidates=str(prov.get("candidates", "?")),
+        runs_per_candidate=str(prov.get("runs per candidate", "?")),
+        date=str(prov.get("date (UTC)", "?")),
+        commit=str(prov.get("commit", "?"))[:10],
+    )
+
+
+def _preregistration(prereg: Mapping[str, Any], meta: Mapping[str, str]) -> Preregistration:
     runs = prereg["runs"]
     per = runs if isinstance(runs, Mapping) else dict.fromkeys(prereg["models"], runs)
-    runs_text = ", ".join(f"{per[m]} on '{m}'" for m in prereg["models"])
-    setting = (
-        "A comparison at equal compute in three steps (`rsmhp.pipeline.protocol`). **Tuning**, "
-        f"on a seed stream of its own: {prov.get('candidates', '?')} candidate configurations "
-        "(every sampled-cost member with every optimiser budget: iterations and restarts; "
-        "tree searches with several widening and UCB constants) in "
-        f"{prov.get('runs per candidate', '?')} closed-loop runs each and in an interleaved "
-        "timing; per model, family and budget the rule picks the lowest tuning error among "
-        "the candidates whose cost per step is within the budget, the cost being the larger "
-        "of the median interleaved time and the mean time per step of the candidate's own "
-        f"closed-loop tuning runs ({prov.get('date (UTC)', '?')}, commit "
-        f"{str(prov.get('commit', '?'))[:10]}; `config/tuned.yaml`). **Preregistration**: "
-        f"`{prereg_meta['path']}` (sha256 {prereg_meta['sha256'][:12]}, commit "
-        f"{prereg_meta['commit'][:10]}) fixes the members, budgets "
-        f"({', '.join(param_text(float(b)) for b in prereg['budgets_ms'])} ms of planning per "
-        f"step, wall clock on the tuning machine; the claims at "
-        f"{param_text(float(prereg['headline_budget_ms']))} ms), the rules and the run counts "
-        f"({runs_text}; {prereg.get('power_text', '')}) before the **confirmatory run**, on "
-        f"a stream of its own ('{prereg.get('stream', 'confirm')}'), which gives every number "
-        "below. Times are remeasured here "
-        "(interleaved, round robin, a job holding the cores); model steps (one step of one "
-        "covariance recursion) do not depend on the machine."
+    return Preregistration(
+        path=meta["path"],
+        sha256=meta["sha256"][:12],
+        commit=meta["commit"][:10],
+        budgets_ms=", ".join(param_text(float(b)) for b in prereg["budgets_ms"]),
+        headline_ms=param_text(float(prereg["headline_budget_ms"])),
+        runs=[RunCount(str(m), str(per[m])) for m in prereg["models"]],
+        power_text=str(prereg.get("power_text", "")),
+        stream=str(prereg.get("stream", "confirm")),
     )
-    fr = [c for c in claims if c.id.startswith("FR-")]
-    found = "; ".join(
-        f"{c.id} {fmt(c.key.value, 3, True)} m {fmt_ci(c.key.ci_low, c.key.ci_high, 3, True)} "
-        f"({c.verdict})"
-        for c in fr
-    )
-    body = "\n".join(
-        [
-            setting,
-            "",
-            (f"Preregistered claims (before Holm's correction): {found}. " if fr else "")
-            + (
-                "Holm (ledger) spans the FR and HZ claims with a p-value; HZ-4 and HZ-5 have "
-                "none (narrower than preregistered). "
-                if fr
-                else ""
-            )
-            + _headline_compute(lad, float(prereg["headline_budget_ms"]))
-            + (
-                "A first confirmatory run (budgeted on timed medians) is superseded: appendix, "
-                "not counted."
-                if superseded
-                else ""
-            ),
-            "",
-            "![Confirmatory ladder](figures/dec_confirm.png)",
-            "",
-            "*Tuned members along the budget ladder, one line per family: closed-loop error − "
-            "NBO's against planning ms per step as the budget counts it (top: max of timed "
-            "median and closed-loop mean; hollow: the latter) and model steps per step "
-            "(middle); "
-            "probability of improvement over the Monte-Carlo member at the same budget "
-            "(bottom); bars: 95% t CIs over runs.*",
-        ]
-    )
+
+
+def _tree_depths(summary: pd.DataFrame) -> TreeDepths | None:
     dpw = summary[summary["family"] == "dpw"]
-    appendix = "\n".join(
-        [
-            "Every configuration of the confirmatory run: interleaved planning ms per step "
-            "(median over the timed belief states; range of the per-pass medians), the "
-            "closed loop's own planning ms per step (median over runs of a run's mean, "
-            "measured beside another job: a run's mean includes the slow steps the median "
-            "of the timing hides), model steps per step, optimiser iterations (summed over "
-            "restarts; simulations for the tree search) and "
-            "converged share (sampled-cost planners), the tree search's depth statistics "
-            "(steps of the plan taken from the tree, deepest node, root actions; means over "
-            "steps and runs), mean error and its difference with NBO (95% t CI over runs).",
-            "",
-            tables["dec_confirm"],
-            "",
-            "The ladder: per model, budget and family the tuned configuration against the "
-            "Monte-Carlo member at the same budget (difference and probability of "
-            "improvement, 95% t CIs over runs; within: its time on this run within the "
-            "budget).",
-            "",
-            tables["dec_confirm_ladder"],
-            "",
-            "What the tuning chose (tuning stream; the numbers the rule saw):",
-            "",
-            tables["dec_confirm_tuning"],
-            "",
-            _best_per_budget(lad),
-            "",
-            (
-                f"Tree search: {len(dpw)} tuned configurations; their plans take "
-                f"{fmt(float(dpw['plan_depth'].min()), 3)} to "
-                f"{fmt(float(dpw['plan_depth'].max()), 3)} of their steps from the tree "
-                f"(deepest nodes {fmt(float(dpw['max_depth'].min()), 3)} to "
-                f"{fmt(float(dpw['max_depth'].max()), 3)}), the rest from the pursuit "
-                "rollout policy (steer to the estimate, close the range). Constants in the "
-                "member names (`_ka`, `_ko`, `_ao`, `_c`: action and observation widening, "
-                "UCB; defaults c = 0.5, k_a = 4, α_a = 0.25, k_o = 4, α_o = 0.25)."
-                if len(dpw)
-                else "No tree search was tuned into the ladder."
-            ),
-            "",
-            "Exploratory results published at 76a0c01 (chosen and judged on one stream; "
-            "kept for the record, not counted):",
-            "",
-            _exploratory_table(exploratory),
-            *(_superseded_text(superseded) if superseded else []),
-        ]
+    if not len(dpw):
+        return None
+    return TreeDepths(
+        configurations=len(dpw),
+        plan_depth_min=fmt(float(dpw["plan_depth"].min()), 3),
+        plan_depth_max=fmt(float(dpw["plan_depth"].max()), 3),
+        max_depth_min=fmt(float(dpw["max_depth"].min()), 3),
+        max_depth_max=fmt(float(dpw["max_depth"].max()), 3),
+    )
+
+
+def _superseded(sup: Mapping[str, Any] | None) -> Superseded | None:
+    if not sup:
+        return None
+    pre = sup.get("preregistration", {})
+    return Superseded(
+        sha256=str(pre.get("sha256", "?"))[:12],
+        commit=str(pre.get("commit", "?"))[:10],
+        what=str(sup.get("what", "")),
+        table=_exploratory_table(sup.get("claims", [])),
+    )
+
+
+def confirm_section(inputs: ConfirmInputs) -> Section:
+    """The equal-compute study's report section (order 32) from the confirmatory run of the
+    protocol (:mod:`rsmhp.pipeline.protocol`); the FR claims are the ledger's, the exploratory
+    and superseded claims are printed in the appendix (kept, not counted)."""
+    fr = [c for c in inputs.claims if c.id.startswith("FR-")]
+    superseded = _superseded(inputs.superseded)
+    body = _render(
+        "confirm.md",
+        tuning=_tuning(inputs.tuned),
+        prereg=_preregistration(inputs.prereg, inputs.prereg_meta),
+        claims=[
+            ConfirmedClaim(
+                id=c.id,
+                value=fmt(c.key.value, 3, True),
+                ci=fmt_ci(c.key.ci_low, c.key.ci_high, 3, True),
+                verdict=c.verdict,
+            )
+            for c in fr
+        ],
+        compute=_headline_compute(inputs.lad, float(inputs.prereg["headline_budget_ms"])),
+        superseded=superseded,
+    )
+    appendix = _render(
+        "confirm_appendix.md",
+        config_table=inputs.tables["dec_confirm"],
+        ladder_table=inputs.tables["dec_confirm_ladder"],
+        tuning_table=inputs.tables["dec_confirm_tuning"],
+        best=_best_per_budget(inputs.lad),
+        tree=_tree_depths(inputs.summary),
+        exploratory_table=_exploratory_table(inputs.exploratory),
+        superseded=superseded,
     )
     return Section(
         key="decisions_frontier",
         title="Planners at equal compute (confirmatory)",
         order=32,
         body=body,
-        claims=list(claims),
+        claims=list(inputs.claims),
         figures=["dec_confirm"],
         appendix=appendix,
     )

@@ -1,14 +1,19 @@
 """Report section of the summary across scenarios (:mod:`rsmhp.studies.scenarios.summarise`): one
 sentence per group in the main text, the per-method table and the per-scenario table in the
-appendix. Numbers come from the tables; nothing is a claim."""
+appendix. Numbers come from the tables; nothing is a claim. The prose is in the templates
+``section.md`` (main text) and ``appendix.md`` beside this module."""
 
 from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
 
 import pandas as pd
 
 from rsmhp.report.ledger import Section
 from rsmhp.report.markdown import ci_cells, fmt, markdown_table
 from rsmhp.report.palette import method_label
+from rsmhp.report.templates import render
 from rsmhp.studies.scenarios.summarise import ALL_GROUP
 
 __all__ = ["ORDER", "TABLES", "scenarios_section", "scenarios_tables"]
@@ -48,57 +53,70 @@ def scenarios_tables(summary: pd.DataFrame, per: pd.DataFrame) -> dict[str, str]
     }
 
 
-def _one(r) -> str:
-    return f"{method_label(r.method)} {fmt(r.p_improve, 2)} [{fmt(r.low, 2)}, {fmt(r.high, 2)}]"
+@dataclass(frozen=True)
+class Estimate:
+    """One method's probability of beating NBO on a group, formatted: ``p`` in ``[low, high]``."""
+
+    label: str
+    p: str
+    low: str
+    high: str
 
 
-def _group_text(summary: pd.DataFrame, group: str) -> str:
+@dataclass(frozen=True)
+class GroupText:
+    """What the main text says of a group of scenarios: its size, and its highest and lowest
+    method (``lowest`` is ``None`` when the group has one method)."""
+
+    group: str
+    scenarios: int
+    methods: int
+    highest: Estimate
+    lowest: Estimate | None
+
+
+def _estimate(r: pd.Series) -> Estimate:
+    return Estimate(
+        method_label(r["method"]), fmt(r["p_improve"], 2), fmt(r["low"], 2), fmt(r["high"], 2)
+    )
+
+
+def _group_text(summary: pd.DataFrame, group: str) -> GroupText:
     """The group's highest and lowest method with their intervals (all in the appendix)."""
     g = summary[summary["group"] == group].sort_values("p_improve", ascending=False)
-    n = int(g["scenarios"].max())
     top, low = g.iloc[0], g.iloc[-1]
-    if len(g) == 1:
-        return f"{group} ({n}): {_one(top)}"
-    return f"{group} ({n}, {len(g)} methods): highest {_one(top)}, lowest {_one(low)}"
+    return GroupText(
+        group=group,
+        scenarios=int(g["scenarios"].max()),
+        methods=len(g),
+        highest=_estimate(top),
+        lowest=_estimate(low) if len(g) > 1 else None,
+    )
+
+
+def _render(template: str, **values: Any) -> str:
+    """``template`` filled with ``values``, without the newline that ends the file."""
+    return render(__package__, template, **values).removesuffix("\n")
 
 
 def scenarios_section(summary: pd.DataFrame, tables: dict[str, str]) -> Section:
-    """The section (order :data:`ORDER`): in the main text the probability of improvement
-    over NBO of every method on each group of scenarios, the figure; the tables in the
-    appendix."""
+    """The section (order :data:`ORDER`; text in ``section.md`` and ``appendix.md``): in the
+    main text the probability of improvement over NBO of every method on each group of
+    scenarios, the figure; the tables in the appendix."""
     groups = [g for g in dict.fromkeys(summary["group"]) if g != ALL_GROUP]
-    if summary.empty:
-        body = "No scenario has paired closed-loop runs of a method and NBO."
-    else:
-        body = (
-            "P(a method's closed-loop run beats NBO's paired run), mean over scenarios, 95% "
-            "stratified bootstrap, descriptive (appendix: every method): "
-            + "; ".join(_group_text(summary, g) for g in groups)
-            + ". Wins, not metres: most runs can be won by centimetres (UAV-2: equivalent)."
-        )
-    appendix = "\n".join(
-        [
-            "A scenario is a map cell (decision study, H = 6, its stream) or a (model, H) of "
-            "the long-horizon closed loop (confirmatory stream); in each, run r of every "
-            "method faces the same draw. Per scenario p_s = share of runs where the method's "
-            "mean location error is below NBO's (ties 1/2); per group the mean of p_s over "
-            "its scenarios, 95% percentile interval of a bootstrap that resamples runs "
-            "within every scenario.",
-            "",
-            tables["scn_improvement"],
-            "",
-            "Per scenario:",
-            "",
-            tables["scn_per_scenario"],
-        ]
-    )
     return Section(
         key="scenarios",
         title="Across scenarios: probability of beating NBO",
         order=ORDER,
-        body=body + "\n\n![Probability of beating NBO](figures/scn_improvement.png)\n\n"
-        "*P(run beats NBO's paired run) per method and group of scenarios; bars: 95% "
-        "stratified bootstrap.*",
+        body=_render(
+            "section.md",
+            empty=summary.empty,
+            groups=[_group_text(summary, g) for g in groups],
+        ),
         figures=["scn_improvement"],
-        appendix=appendix,
+        appendix=_render(
+            "appendix.md",
+            improvement_table=tables["scn_improvement"],
+            per_scenario_table=tables["scn_per_scenario"],
+        ),
     )

@@ -1,0 +1,96 @@
+"""The scenarios section's prose templates (``section.md``, ``appendix.md``), rendered on small
+data: every name a template uses is a value the section passes and no other, the rendered text
+keeps no template syntax, and a missing value is an error (StrictUndefined), never an empty
+string."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import jinja2
+import numpy as np
+import pytest
+from jinja2 import meta
+
+from rsmhp.report.templates import render
+from rsmhp.studies.scenarios import section
+from rsmhp.studies.scenarios.summarise import (
+    HORIZON_GROUP,
+    MAP_GROUP,
+    improvement_summary,
+    per_scenario,
+    scenario_runs,
+)
+from tests.studies.scenarios.test_scenarios import _tables
+
+PACKAGE = "rsmhp.studies.scenarios"
+HERE = Path(section.__file__).parent
+SYNTAX = ("{{", "}}", "{%", "%}", "{#", "#}")
+
+
+@pytest.fixture
+def data():
+    runs = scenario_runs(*_tables(np.random.default_rng(5)))
+    s = improvement_summary(runs, n_boot=200, seed=0)
+    return s, section.scenarios_tables(s, per_scenario(runs))
+
+
+@pytest.fixture
+def rendered(monkeypatch, data) -> dict[str, tuple[dict, str]]:
+    """``{template: (values, text)}`` of every template the section renders."""
+    calls: dict[str, tuple[dict, str]] = {}
+    real = section.render
+
+    def spy(package, template, /, **values):
+        text = real(package, template, **values)
+        calls[template] = (values, text)
+        return text
+
+    monkeypatch.setattr(section, "render", spy)
+    section.scenarios_section(*data)
+    return calls
+
+
+def test_every_template_gets_exactly_the_values_it_uses(rendered):
+    assert set(rendered) == {p.name for p in HERE.glob("*.md")}
+    env = jinja2.Environment()
+    for name, (values, text) in rendered.items():
+        used = meta.find_undeclared_variables(env.parse((HERE / name).read_text("utf-8")))
+        assert used == set(values), name
+        assert not any(s in text for s in SYNTAX), name
+        # the file's last newline (the section drops it), one blank line between paragraphs
+        assert text.endswith("\n") and not text.endswith("\n\n"), name
+        assert "\n\n\n" not in text, name
+        prose = [line for line in text.splitlines() if not line.startswith("|")]
+        assert not any("  " in line or line != line.strip() for line in prose), name
+
+
+def test_the_prose_is_complete(data):
+    summary, tables = data
+    sec = section.scenarios_section(summary, tables)
+    assert sec.body.startswith("P(a method's closed-loop run beats NBO's paired run), mean over")
+    assert f"(appendix: every method): {MAP_GROUP} (2, 2 methods): highest " in sec.body
+    assert f"; {HORIZON_GROUP} (3, 2 methods): highest " in sec.body
+    assert ". Wins, not metres: most runs can be won by centimetres (UAV-2: equivalent).\n\n" in (
+        sec.body
+    )
+    assert sec.body.endswith("bars: 95% stratified bootstrap.*")
+    assert sec.appendix.startswith("A scenario is a map cell (decision study, H = 6, its stream)")
+    assert sec.appendix.endswith(tables["scn_per_scenario"])
+    assert f"\n\n{tables['scn_improvement']}\n\nPer scenario:\n\n" in sec.appendix
+    # a group with one method names it once; no data: one sentence
+    one = section.scenarios_section(summary.groupby("group").head(1), tables)
+    assert f"{MAP_GROUP} (2): " in one.body and "highest" not in one.body
+    empty = section.scenarios_section(summary.iloc[:0], tables)
+    assert empty.body.startswith("No scenario has paired closed-loop runs of a method and NBO.\n\n")
+
+
+def test_a_missing_value_is_an_error(rendered):
+    for name, (values, _) in rendered.items():
+        for missing in values:
+            rest = {k: v for k, v in values.items() if k != missing}
+            with pytest.raises(jinja2.UndefinedError, match=f"'{missing}' is undefined"):
+                render(PACKAGE, name, **rest)
+    group = {"group": "g", "scenarios": 2, "methods": 2, "lowest": None}  # no "highest"
+    with pytest.raises(jinja2.UndefinedError, match="highest"):
+        render(PACKAGE, "section.md", empty=False, groups=[group])
