@@ -170,13 +170,28 @@ def _rule_blocks() -> dict[str, str]:
 
 
 def test_every_rule_with_a_script_carries_the_digest_of_that_script():
-    """A rule that runs package code without a `code` param would never rerun on a change."""
+    """A rule that runs package code without a `code` param would never rerun on a change; a
+    rule that restricts its digest to some method families passes the same families as its
+    `families` param (the job checks its code with them)."""
     blocks = _rule_blocks()
     scripted = {r: b for r, b in blocks.items() if "script:" in b}
     assert len(scripted) >= 20
+    restricted = 0
     for rule, block in scripted.items():
         script = re.search(r'script:\s*\n\s*"\.\./scripts/(\w+\.py)"', block).group(1)
-        assert f'code=code_digest("workflow/scripts/{script}")' in block, rule
+        whole = f'code=code_digest("workflow/scripts/{script}")' in block
+        m = re.search(
+            r'code=(?:lambda wc: )?code_digest\(\s*"workflow/scripts/' + re.escape(script)
+            + r'",\s*(.+?)\s*\),\n',
+            block,
+            re.S,
+        )
+        assert whole or m, rule
+        if m:
+            restricted += 1
+            fams = re.search(r"families=(?:lambda wc: )?(.+?),\n", block)
+            assert fams and fams.group(1).strip() == m.group(1).strip(), rule
+    assert restricted >= 10  # every rule that runs UAV planners
 
 
 def test_every_rule_script_hands_the_snakemake_object_to_rule_logging():
@@ -208,3 +223,56 @@ def test_an_import_docstring_example_in_a_module_is_not_an_import(tmp_path):
     script = tmp_path / "s.py"
     script.write_text(textwrap.dedent("import rsmhp.x\n"))
     assert set(describe(script, src).modules) == {"s.py", "rsmhp", "rsmhp.x"}
+
+
+def test_only_restricts_a_dynamic_registry_to_the_named_modules(tree):
+    """A job that runs some method families counts only their modules of the registry:
+    adding or editing another family's module leaves its digest alone."""
+    _, src = tree
+    script = src.parent / "workflow/scripts/rule_reg.py"
+    script.write_text("from rsmhp import reg\n")
+    only = {"rsmhp.reg": ["rsmhp.reg.one"]}
+    full, restricted = describe(script, src), describe(script, src, only)
+    assert {"rsmhp.reg.one", "rsmhp.reg.two"} <= set(full.modules)
+    assert "rsmhp.reg.one" in restricted.modules and "rsmhp.reg.two" not in restricted.modules
+    (src / "rsmhp/reg/three.py").write_text("THREE = 3\n")
+    _edit(src / "rsmhp/reg/two.py", "TWO = 2", "TWO = 22")
+    assert describe(script, src, only).digest == restricted.digest
+    assert describe(script, src).digest != full.digest
+    _edit(src / "rsmhp/reg/one.py", "ONE = 1", "ONE = 11")
+    assert describe(script, src, only).digest != restricted.digest
+    with pytest.raises(ValueError, match="not modules of it"):
+        describe(script, src, {"rsmhp.reg": ["rsmhp.other"]})
+    assert cd.method_only(["nbo", "monte_carlo"]) == {
+        cd.METHOD_REGISTRY: [f"{cd.METHOD_REGISTRY}.monte_carlo", f"{cd.METHOD_REGISTRY}.nbo"]
+    }
+    assert cd.split_stamp_rule("uav_simulate+monte_carlo,nbo") == (
+        "uav_simulate",
+        ["monte_carlo", "nbo"],
+    )
+    assert cd.split_stamp_rule("report") == ("report", None)
+
+
+def test_a_template_counts_for_the_modules_that_render_it(tree):
+    """A Markdown template beside a module is code of the modules naming it (rendering it),
+    not of the other modules of that folder: a prose edit reruns no simulation."""
+    _, src = tree
+    _write(
+        src / "rsmhp",
+        {
+            "st/__init__.py": "",
+            "st/simulate.py": "def run():\n    return 1\n",
+            "st/section.py": "from rsmhp.st import simulate\n\nNAME = 'section.md'\n",
+            "st/section.md": "The {{ value }} of the study.\n",
+        },
+    )
+    scripts = src.parent / "workflow/scripts"
+    sim, summary = scripts / "sim.py", scripts / "summary.py"
+    sim.write_text("from rsmhp.st import simulate\n")
+    summary.write_text("from rsmhp.st import section\n")
+    before_sim, before_summary = describe(sim, src), describe(summary, src)
+    assert "rsmhp.st/section.md" in before_summary.modules
+    assert not any(k.endswith(".md") for k in before_sim.modules)
+    _edit(src / "rsmhp/st/section.md", "The {{ value }}", "A {{ value }}")
+    assert describe(sim, src).digest == before_sim.digest
+    assert describe(summary, src).digest != before_summary.digest

@@ -8,7 +8,7 @@ import pandas as pd
 from rsmhp.pipeline.contracts import read_checked
 from rsmhp.pipeline.io import read_table, write_csv, write_text
 from rsmhp.pipeline.script import rule_logging
-from rsmhp.studies.horizon.section import horizon_section, horizon_tables
+from rsmhp.studies.horizon.section import HorizonInputs, horizon_section, horizon_tables
 from rsmhp.studies.horizon.section_optimiser import SUMMARY_COLUMNS as OPTIMISER_COLUMNS
 from rsmhp.studies.horizon.simulate_lqg import estimator_contract, regret_contract
 from rsmhp.studies.horizon.simulate_uav import closed_contract, horizon_contracts
@@ -52,9 +52,25 @@ with rule_logging(snakemake) as log:
     opt = snakemake.input.optimiser
     optimiser = read_table(opt[0], OPTIMISER_COLUMNS) if opt else None
     section = horizon_section(
-        approx, a_sum, r_sum, tables, p.cfg, p.seed, lqg_table, lq, model["a"], closed,
-        c_sum, est, est_sum, reg_sum, planner=p.planner, optimiser=optimiser,
-    )  # fmt: skip
+        HorizonInputs(
+            approx=approx,
+            approx_summary=a_sum,
+            regret_summary=r_sum,
+            tables=tables,
+            cfg=p.cfg,
+            seed=p.seed,
+            lqg_table=lqg_table,
+            lqg_cfg=lq,
+            a_model=model["a"],
+            closed=closed,
+            closed_summary=c_sum,
+            lqg_est=est,
+            lqg_est_summary=est_sum,
+            lqg_regret_summary=reg_sum,
+            planner=p.planner,
+            optimiser=optimiser,
+        )
+    )
     write_csv(a_sum, snakemake.output.approx)
     write_csv(r_sum, snakemake.output.regret)
     write_csv(c_sum, snakemake.output.closed)

@@ -26,9 +26,12 @@ depend on the Python version's node layout): an edit that changes only comments,
 lines, line breaks, quotes or other formatting keeps the digest; any change of code or of a
 docstring changes it. The digest is the first 12 hex digits of a SHA-256 over the sorted
 (module, module digest) pairs; it does not depend on where the checkout lives. Report templates
-count as code: every ``*.md`` file in the directory of a covered module (a study's section
-templates, :mod:`rsmhp.report.templates`) is hashed byte for byte under the name
-``<package>/<file>``. Not covered: third-party packages (``results/provenance.json`` records
+count as code of the modules that render them: a ``*.md`` file beside a covered module whose
+code names it in a string constant (``render("rsmhp.studies.lqg", "section.md", ...)``,
+:mod:`rsmhp.report.templates`) is hashed byte for byte under the name ``<package>/<file>``; a
+prose edit reruns the rules whose code renders that template, and never a study's simulation
+(its ``simulate`` modules render nothing). Not covered: third-party packages
+(``results/provenance.json`` records
 their versions), other data files the code reads, and modules reached only through a string
 the analysis cannot see.
 
@@ -137,6 +140,9 @@ class _Module:
     # module; resolved against the file tree by the caller)
     imports: tuple[str, ...]
     dynamic: bool
+    # file names ending in ".md" written as string constants in the module (the templates it
+    # renders, :mod:`rsmhp.report.templates`)
+    templates: tuple[str, ...] = ()
 
 
 def _analyse(source: bytes, name: str, is_package: bool, disk: _DiskCache | None) -> _Module:
@@ -184,7 +190,13 @@ def _analyse_source(source: bytes, name: str, is_package: bool) -> _Module:
             if called in _DYNAMIC:
                 dynamic = True
     wanted = tuple(sorted({m for m in imports if m.split(".")[0] == _PACKAGE}))
-    return _Module(_hex("".join(text).encode()), wanted, dynamic)
+    tree_strings = {
+        n.value
+        for n in ast.walk(ast.parse(source))
+        if isinstance(n, ast.Constant) and isinstance(n.value, str)
+    }
+    templates = tuple(sorted(v for v in tree_strings if v.endswith(".md") and "/" not in v))
+    return _Module(_hex("".join(text).encode()), wanted, dynamic, templates)
 
 
 class _DiskCache:
@@ -193,7 +205,7 @@ class _DiskCache:
     their code, do not parse every module again. Keyed by the source's SHA-256, so it can
     never serve an outdated analysis; unreadable or unwritable: not used."""
 
-    _FORMAT = 1  # bump when the analysis changes
+    _FORMAT = 2  # bump when the analysis changes
     _MAX = 4000  # entries kept (the oldest go first)
 
     def __init__(self, src: Path) -> None:
@@ -212,11 +224,11 @@ class _DiskCache:
         value = self.entries.get(key)
         if value is None:
             return None
-        digest, imports, dynamic = value
-        return _Module(digest, tuple(imports), bool(dynamic))
+        digest, imports, dynamic, templates = value
+        return _Module(digest, tuple(imports), bool(dynamic), tuple(templates))
 
     def put(self, key: str, mod: _Module) -> None:
-        self.entries[key] = [mod.digest, list(mod.imports), mod.dynamic]
+        self.entries[key] = [mod.digest, list(mod.imports), mod.dynamic, list(mod.templates)]
         self.new += 1
 
     def save(self) -> None:
@@ -309,6 +321,7 @@ def describe(
     digests = {script.name: top.digest}
     todo = list(top.imports)
     seen: set[str] = set()
+    rendered: dict[str, tuple[Path, str, tuple[str, ...]]] = {}
     while todo:
         name = todo.pop()
         if name in seen:
@@ -322,18 +335,18 @@ def describe(
         path, is_package = found
         mod = _analyse(path.read_bytes(), name, is_package, disk)
         digests[name] = mod.digest
+        if mod.templates:
+            rendered[name] = (path, name if is_package else name.rpartition(".")[0], mod.templates)
         todo.extend(mod.imports)
         if mod.dynamic:
             package = name if is_package else name.rpartition(".")[0]
             todo.extend(only[package] if package in only else _package_modules(package, src))
     if disk is not None:
         disk.save()
-    for name in [n for n in digests if n != script.name]:
-        found = _locate(name, src)
-        if found is not None:
-            package = name if found[1] else name.rpartition(".")[0]
-            for template in sorted(found[0].parent.glob("*.md")):
-                digests[f"{package}/{template.name}"] = _hex(template.read_bytes())
+    for path, package, templates in rendered.values():
+        for t in templates:
+            if (path.parent / t).is_file():
+                digests[f"{package}/{t}"] = _hex((path.parent / t).read_bytes())
     modules = dict(sorted(digests.items()))
     text = "".join(f"{k} {v}\n" for k, v in modules.items())
     return CodeDigest(script.name, _hex(text.encode())[:DIGEST_LENGTH], modules)

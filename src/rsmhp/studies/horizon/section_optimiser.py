@@ -6,6 +6,9 @@ the table ``hz_optimiser`` and the figure ``hz_optimiser``. A measurement: no cl
 Every number of the text is read from the summary (:func:`optimiser_summary`) or the config
 (``horizon.optimiser``, ``uav.planner``); none is typed. :func:`horizon_note` is the sentence
 the long-horizon section (:mod:`rsmhp.studies.horizon.section`) uses to say which regret it shows.
+The prose is in the Markdown templates beside this module (``section_optimiser.md``, the main
+text; ``section_optimiser_appendix.md``; ``horizon_note.md``); this module computes the values
+they are filled with (:mod:`rsmhp.report.templates`).
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ import pandas as pd
 from rsmhp.report.ledger import Section
 from rsmhp.report.markdown import ci_cells, fmt, markdown_table, range_text
 from rsmhp.report.palette import method_label
+from rsmhp.report.templates import render
 from rsmhp.studies.horizon.figures_optimiser import (
     FIGURES,
     budget_label,
@@ -49,6 +53,7 @@ TITLE = "Optimiser error apart from approximation error"
 #: right after the long-horizon section (33)
 ORDER = 34
 TABLES = ("hz_optimiser",)
+_PACKAGE = "rsmhp.studies.horizon"
 
 _GROUP = ["model", "H", "method", "family", "maxiter", "restarts"]
 
@@ -151,72 +156,56 @@ def _pct(values: Sequence[float] | pd.Series) -> str:
     return f"{range_text(np.asarray(values, dtype=float), 2)}%"
 
 
-def _budget_config_text(cfg: Mapping[str, Any]) -> str:
-    parts = []
-    for maxiter, maxfun, restarts in config_budgets(cfg):
-        parts.append(f"{budget_label((maxiter, restarts))} (maxfun {maxfun})")
-    return "; ".join(parts)
+def _render(template: str, **values: Any) -> str:
+    """The template ``template`` beside this module (:func:`rsmhp.report.templates.render`)
+    filled with ``values``, without the newline that ends the file: a paragraph or a section
+    text, not a file."""
+    return render(_PACKAGE, template, **values).removesuffix("\n")
 
 
-def _planner_match(cfg: Mapping[str, Any], planner: Mapping[str, Any] | None) -> str:
-    """Whether the first budget is uav.planner's (the closed-loop studies' budget)."""
-    maxiter, maxfun, restarts = config_budgets(cfg)[0]
+def _planner_values(cfg: Mapping[str, Any], planner: Mapping[str, Any] | None) -> dict | None:
+    """Whether the first budget is uav.planner's (the closed-loop studies' budget): None
+    without a planner, else ``same`` and uav.planner's budget label and maxfun."""
     if planner is None:
-        return "The first budget is the default the others are compared with."
+        return None
+    maxiter, maxfun, restarts = config_budgets(cfg)[0]
     mine = (int(planner["maxiter"]), int(planner["maxfun"]), int(planner.get("restarts", 0)))
-    if mine == (maxiter, maxfun, restarts):
-        return (
-            "The first budget is uav.planner's, the budget of every closed-loop study and of "
-            "the long-horizon section's regret."
-        )
-    return (
-        f"The first budget is the default the others are compared with; uav.planner's ("
-        f"{budget_label((mine[0], mine[2]))}, maxfun {mine[1]}), the budget of the "
-        "closed-loop studies, differs from it."
-    )
+    return {
+        "same": mine == (maxiter, maxfun, restarts),
+        "budget": budget_label((mine[0], mine[2])),
+        "maxfun": mine[1],
+    }
 
 
-def _definitions(cfg: Mapping[str, Any]) -> str:
-    return (
-        "At each belief state a method m plans by minimising its own cost J_m (the sum over "
-        "its hypotheses of the trace of the predicted covariance, Σ tr P) from the warm start "
-        "under an optimiser budget b (iterations, evaluations, restarts). Every plan is scored "
-        "on the decision study's evaluation cost J_ev (independent hypotheses, the same for "
-        "every method and budget). **Total regret** R(m, b) = (J_ev(plan) − J_ref) / J_ref, "
-        "against the best plan found, J_ref (the lowest J_ev of every plan evaluated at the "
-        "state, a multi-start polish of J_ev included). **Approximation regret** A(m) = the "
-        "regret of x*_m, the near-global minimiser of the method's own cost (the best on J_m "
-        f"of the budget plans and of a polish, {int(cfg['polish_maxiter'])} iterations, from "
-        f"{int(cfg['polish_starts'])} uniform starts and from every budget plan): what even a "
-        "perfect optimiser of J_m loses because J_m ≠ J_ev. **Optimisation regret** O(m, b) = "
-        "R − A: what the optimiser loses by stopping at a poorer point of J_m (it can be "
-        "negative: a poorer minimiser of J_m can be better on J_ev by chance)."
-    )
-
-
-def _setting(summary: pd.DataFrame, cfg: Mapping[str, Any], planner: Mapping | None) -> str:
-    models = list(dict.fromkeys(summary["model"]))
-    hs = sorted(int(h) for h in summary["H"].unique())
-    methods = list(dict.fromkeys(summary["method"]))
+def _appendix_values(
+    summary: pd.DataFrame, cfg: Mapping[str, Any], planner: Mapping | None
+) -> dict[str, Any]:
+    """The values of the definitions and the setting (``section_optimiser_appendix.md``)."""
     states = summary["states"].astype(int)
-    n_states = (
-        f"{int(states.iloc[0])} states per (model, H)"
-        if states.nunique() == 1
-        else f"{int(states.min())} to {int(states.max())} states per (model, H)"
-    )
-    return (
-        f"H ∈ {{{', '.join(map(str, hs))}}} on {', '.join(repr(m) for m in models)}; belief "
-        f"states of {int(cfg['runs'])} NBO runs at steps "
-        f"{', '.join(str(int(s)) for s in sorted(cfg['steps']))} ({n_states}, the same at "
-        f"every H); methods {', '.join(method_label(m) for m in methods)}; budgets "
-        f"{_budget_config_text(cfg)}. {_planner_match(cfg, planner)} Means over states, "
-        "95% cluster-t CIs over runs (table hz_optimiser in the appendix)."
-    )
+    hs = sorted(int(h) for h in summary["H"].unique())
+    return {
+        "polish_maxiter": int(cfg["polish_maxiter"]),
+        "polish_starts": int(cfg["polish_starts"]),
+        "horizons": "{" + ", ".join(map(str, hs)) + "}",
+        "models": ", ".join(repr(m) for m in dict.fromkeys(summary["model"])),
+        "runs": int(cfg["runs"]),
+        "steps": ", ".join(str(int(s)) for s in sorted(cfg["steps"])),
+        "states_min": int(states.min()),
+        "states_max": int(states.max()),
+        "methods": ", ".join(method_label(m) for m in dict.fromkeys(summary["method"])),
+        "budgets": [
+            {"label": budget_label((maxiter, restarts)), "maxfun": maxfun}
+            for maxiter, maxfun, restarts in config_budgets(cfg)
+        ],
+        "planner": _planner_values(cfg, planner),
+    }
 
 
-def _split_text(summary: pd.DataFrame, first: tuple[int, int], big: tuple[int, int]) -> str:
-    """Per model and H, the ranges over methods of R, A and O at the default budget, and R
-    and O at the largest H and budget."""
+def _split_values(
+    summary: pd.DataFrame, first: tuple[int, int], big: tuple[int, int]
+) -> list[dict[str, Any]]:
+    """Per model and H, the ranges over methods of R, A and O at the default budget; R and O
+    at the largest H and budget (``big``: None where that is the default or was not run)."""
     out = []
     hs = sorted(int(h) for h in summary["H"].unique())
     h_hi = hs[-1]
@@ -228,93 +217,64 @@ def _split_text(summary: pd.DataFrame, first: tuple[int, int], big: tuple[int, i
             if g.empty:
                 continue
             cells.append(
-                f"H = {h}: R {_pct(g['regret_pct'])}, A {_pct(g['approx_pct'])}, O "
-                f"{_pct(g['optim_pct'])}"
+                {
+                    "H": h,
+                    "R": _pct(g["regret_pct"]),
+                    "A": _pct(g["approx_pct"]),
+                    "O": _pct(g["optim_pct"]),
+                }
             )
-        text = f"'{model}', {budget_label(first)}: " + "; ".join(cells)
         g = _at(s, big)
         g = g[g["H"] == h_hi]
-        if big != first and not g.empty:
-            text += (
-                f"; with {budget_label(big)} at H = {h_hi}: R {_pct(g['regret_pct'])}, O "
-                f"{_pct(g['optim_pct'])}"
-            )
-        out.append(text + ".")
-    return (
-        "Measured split (ranges over the methods; per method in table hz_optimiser): "
-        + " ".join(out)
-    )
-
-
-def _iterations_text(summary: pd.DataFrame, first: tuple[int, int]) -> str:
-    """Iterations, convergence and plans at 0 iterations at the default budget; what more
-    iterations without restarts change."""
-    d = _at(summary, first)
-    conv = 100 * _weighted(d, "converged_share")
-    zero = 100 * _weighted(d, "zero_nit_share")
-    stopped = (
-        f"{fmt(zero, 2)}% of the plans stopped at 0 iterations, i.e. they are the warm start itself"
-        if zero > 0
-        else "no plan stopped at 0 iterations"
-    )
-    text = (
-        f"At {budget_label(first)} the optimiser used {range_text(d['mean_nit'].to_numpy(), 2)} "
-        "iterations on average (per model, H and method) and reported convergence for "
-        f"{fmt(conv, 2)}% of the plans; {stopped}."
-    )
-    if zero > 0:
-        text += (
-            " 'Converged' is therefore no sign of a good plan here: the warm start (the "
-            "previous plan shifted by one step, its last control held) keeps controls at the "
-            "bounds of the control box, where the projected gradient can be zero, so the "
-            "optimiser's first convergence test passes before any step and the plan keeps "
-            "its optimisation regret."
+        top = (
+            {"R": _pct(g["regret_pct"]), "O": _pct(g["optim_pct"])}
+            if big != first and not g.empty
+            else None
         )
+        out.append({"model": model, "cells": cells, "big": top})
+    return out
+
+
+def _iteration_values(summary: pd.DataFrame, first: tuple[int, int]) -> dict[str, Any]:
+    """Iterations, convergence and plans at 0 iterations at the default budget (``zero``:
+    None if no plan stopped there); what more iterations without restarts change (``more``:
+    None with only one such budget)."""
+    d = _at(summary, first)
+    zero = 100 * _weighted(d, "zero_nit_share")
     plain = sorted(b for b in budget_order(summary) if b[1] == first[1])
+    more = None
     if len(plain) > 1:
         lo, hi = _at(summary, plain[0]), _at(summary, plain[-1])
-        text += (
-            f" Raising maxiter from {plain[0][0]} to {plain[-1][0]} (restarts {first[1]}) "
-            "moves the mean optimisation part over the cells from "
-            f"{fmt(float(lo['optim_pct'].mean()), 2)}% to {fmt(float(hi['optim_pct'].mean()), 2)}"
-            f"% (mean iterations {fmt(_weighted(lo, 'mean_nit'), 2)} and "
-            f"{fmt(_weighted(hi, 'mean_nit'), 2)} over all plans)."
-        )
-    return text
+        more = {
+            "maxiter_lo": plain[0][0],
+            "maxiter_hi": plain[-1][0],
+            "restarts": first[1],
+            "optim_lo": fmt(float(lo["optim_pct"].mean()), 2),
+            "optim_hi": fmt(float(hi["optim_pct"].mean()), 2),
+            "iterations_lo": fmt(_weighted(lo, "mean_nit"), 2),
+            "iterations_hi": fmt(_weighted(hi, "mean_nit"), 2),
+        }
+    return {
+        "iterations": range_text(d["mean_nit"].to_numpy(), 2),
+        "converged": fmt(100 * _weighted(d, "converged_share"), 2),
+        "zero": fmt(zero, 2) if zero > 0 else None,
+        "more": more,
+    }
 
 
-def _removal_text(summary: pd.DataFrame) -> str:
+def _removal_values(summary: pd.DataFrame) -> dict[str, Any]:
+    """The first budget that removes the optimisation part (``removing``, its label; None if
+    none does) and, if none does, the largest budget's cells (``largest``)."""
     b = removing_budget(summary)
-    order = budget_order(summary)
-    big = largest_budget(order)
-    g = _at(summary, big)
-    if b is not None and b == order[0]:
-        return (
-            f"Already at the default budget, {budget_label(b)}, the optimisation part is at "
-            "most the approximation part in every (model, H, method) cell (per budget below)."
-        )
-    if b is not None:
-        return (
-            f"The first budget at which the optimisation part is at most the approximation "
-            f"part in every (model, H, method) cell is {budget_label(b)} (per budget below)."
-        )
-    return (
-        "No configured budget brings the optimisation part down to the approximation part "
-        f"in every (model, H, method) cell; the largest, {budget_label(big)}, does so in "
-        f"{int((g['optim_pct'] <= g['approx_pct']).sum())} of {len(g)} cells, its largest "
-        f"optimisation part is {fmt(float(g['optim_pct'].max()), 2)}% (per budget below)."
-    )
-
-
-_FIGURE = [
-    "![Optimiser split by horizon](figures/hz_optimiser.png)",
-    "",
-    "*Open-loop regret (% of the best plan found, symmetric log scale) by horizon, per "
-    "method: total at the default budget (solid), total at the largest budget (dashed) and "
-    "the approximation part (dotted); the optimisation part is the gap between a total and "
-    "the approximation part. Bars: 95% cluster-t CIs over runs, cut at 0 (both regrets are "
-    "at least 0 at every state).*",
-]
+    largest = None
+    if b is None:
+        g = _at(summary, largest_budget(budget_order(summary)))
+        largest = {
+            "cells_ok": int((g["optim_pct"] <= g["approx_pct"]).sum()),
+            "cells": len(g),
+            "optim_max": fmt(float(g["optim_pct"].max()), 2),
+        }
+    return {"removing": None if b is None else budget_label(b), "largest": largest}
 
 
 def optimiser_section(
@@ -325,51 +285,28 @@ def optimiser_section(
 ) -> Section:
     """The section (module doc) from :func:`optimiser_summary`; ``cfg`` is
     ``horizon.optimiser``, ``planner`` ``uav.planner`` (maxiter, maxfun, restarts: whether
-    the first budget is the closed-loop studies')."""
+    the first budget is the closed-loop studies'). The text is ``section_optimiser.md``
+    (main text: the split and what removes it) and ``section_optimiser_appendix.md``
+    (definitions, setting, the per-budget table and ``hz_optimiser``)."""
     if summary.empty:
         raise ValueError("optimiser summary is empty: no (model, H) was run")
     order = budget_order(summary)
     first, big = order[0], largest_budget(order)
     per_budget = markdown_table(budget_table(summary), digits=3, signed=("O %", "largest O %"))
-    # the main text: the split and what removes it; definitions, setting and the per-budget
-    # table in the appendix (main-text budget of the report)
-    body = "\n".join(
-        [
-            "R = total open-loop regret of a plan, A = the regret of the near-global "
-            "minimiser of the method's own cost (approximation), O = R − A (optimisation); "
-            "definitions and setting in the appendix.",
-            "",
-            _split_text(summary, first, big),
-            "",
-            _iterations_text(summary, first),
-            "",
-            _removal_text(summary),
-            "",
-            *_FIGURE,
-        ]
+    body = _render(
+        "section_optimiser.md",
+        first=budget_label(first),
+        big=budget_label(big),
+        h_hi=int(summary["H"].max()),
+        split=_split_values(summary, first, big),
+        **_iteration_values(summary, first),
+        **_removal_values(summary),
     )
-    appendix = "\n".join(
-        [
-            _definitions(cfg),
-            "",
-            _setting(summary, cfg, planner),
-            "",
-            "Per budget, over every (model, H, method) cell (iterations, converged and 0 "
-            "iterations: over all plans; R and O: mean of the cells' means):",
-            "",
-            per_budget,
-            "",
-            "Optimiser split per model, horizon, method and budget: R, A, O = total, "
-            "approximation and optimisation regret (percent of the best plan found, mean over "
-            "belief states, 95% cluster-t CIs over runs: jackknife leaving out one run with its "
-            "states, t with runs − 1 df; R = A + O for the means, not the bounds); iterations: "
-            "mean over states (summed over restarts); converged: the winning optimisation "
-            "stopped on a tolerance, not on its budget; 0 iterations: the plan is the warm "
-            "start; x* from polish: states whose near-global minimiser of the method's own "
-            "cost came from the polish rather than a budget plan:",
-            "",
-            tables["hz_optimiser"],
-        ]
+    appendix = _render(
+        "section_optimiser_appendix.md",
+        **_appendix_values(summary, cfg, planner),
+        per_budget=per_budget,
+        table=tables["hz_optimiser"],
     )
     return Section(
         key=KEY,
@@ -383,22 +320,30 @@ def optimiser_section(
 
 
 def horizon_note(summary: pd.DataFrame | None) -> str:
-    """The long-horizon section's pointer to this one: at the largest H of ``summary`` and
-    the default budget, the optimisation and approximation parts over models and methods
-    (and whether the optimisation part is the larger in every cell); without a summary, the
-    pointer alone."""
-    pointer = f"section '{TITLE}'"
+    """The long-horizon section's pointer to this one (``horizon_note.md``): at the largest H
+    of ``summary`` and the default budget, the optimisation and approximation parts over
+    models and methods (and whether the optimisation part is the larger in every cell);
+    without a summary, the pointer alone."""
     if summary is None or summary.empty:
-        return f"How much of it is optimisation error rather than approximation is in {pointer}."
+        return _render(
+            "horizon_note.md",
+            title=TITLE,
+            h_hi=None,
+            first=None,
+            optim=None,
+            approx=None,
+            dominates=False,
+        )
     first = budget_order(summary)[0]
     h_hi = int(summary["H"].max())
     g = _at(summary, first)
     g = g[g["H"] == h_hi]
-    dominates = bool((g["optim_pct"] > g["approx_pct"]).all())
-    return (
-        f"At H = {h_hi} and {budget_label(first)} ({pointer}) the optimisation part of the "
-        f"open-loop regret is {_pct(g['optim_pct'])} and the approximation part "
-        f"{_pct(g['approx_pct'])} "
-        "(over models and methods)"
-        + ("; the optimisation part dominates in every case." if dominates else ".")
+    return _render(
+        "horizon_note.md",
+        title=TITLE,
+        h_hi=h_hi,
+        first=budget_label(first),
+        optim=_pct(g["optim_pct"]),
+        approx=_pct(g["approx_pct"]),
+        dominates=bool((g["optim_pct"] > g["approx_pct"]).all()),
     )
