@@ -181,7 +181,8 @@ def test_every_rule_with_a_script_carries_the_digest_of_that_script():
         script = re.search(r'script:\s*\n\s*"\.\./scripts/(\w+\.py)"', block).group(1)
         whole = f'code=code_digest("workflow/scripts/{script}")' in block
         m = re.search(
-            r'code=(?:lambda wc: )?code_digest\(\s*"workflow/scripts/' + re.escape(script)
+            r'code=(?:lambda wc: )?code_digest\(\s*"workflow/scripts/'
+            + re.escape(script)
             + r'",\s*(.+?)\s*\),\n',
             block,
             re.S,

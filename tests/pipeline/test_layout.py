@@ -18,9 +18,7 @@ import pytest
 
 ROOT = Path(__file__).resolve().parents[2]
 SRC = ROOT / "src"
-STUDIES = sorted(
-    p.name for p in (SRC / "rsmhp/studies").iterdir() if (p / "__init__.py").is_file()
-)
+STUDIES = sorted(p.name for p in (SRC / "rsmhp/studies").iterdir() if (p / "__init__.py").is_file())
 
 
 def _module_name(path: Path) -> str:
