@@ -1,12 +1,15 @@
 """Decision study on the scalar LQG, report section: the Markdown tables, the short body with
 the figure and the findings, and the appendix with the derivations, assembled into a
 :class:`rsmhp.report.ledger.Section` from the claims of :mod:`rsmhp.studies.decisions.claims_lqg`
-and the statistics of :mod:`rsmhp.models.lqg.regret_summary`.
+and the statistics of :mod:`rsmhp.models.lqg.regret_summary`. The prose is in the templates
+beside this module (``section_lqg.md``: body, ``section_lqg_appendix.md``); this module
+computes and formats the values they insert.
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import pandas as pd
@@ -20,12 +23,19 @@ from rsmhp.models.lqg.regret_summary import (
 )
 from rsmhp.report.ledger import Claim, Section
 from rsmhp.report.markdown import fmt, fmt_ci, markdown_table, param_text, range_text
+from rsmhp.report.templates import render
 from rsmhp.studies.decisions.claims_lqg import lqg_claims
 
 __all__ = ["FIGURES", "lqg_decision_section", "lqg_tables", "shown_a"]
 
 #: figure stems of the section (the figure rule writes them; see decisions.smk)
 FIGURES = ("dec_lqg_regret",)
+
+
+def _render(template: str, **values: Any) -> str:
+    """The template ``template`` beside this module filled with ``values``, without the line
+    break that ends the template file."""
+    return render("rsmhp.studies.decisions", template, **values).removesuffix("\n")
 
 
 def _sample_text(row: pd.Series) -> str:
@@ -81,115 +91,106 @@ def lqg_tables(
     }
 
 
-def _findings(claims: Sequence[Claim], summary: pd.DataFrame, scaling: pd.DataFrame) -> str:
-    """One short paragraph of results, every number from the claims and fits."""
-    c = {claim.id: claim for claim in claims}
-    out = []
-    if "DEC-1" in c:
-        exact = c["DEC-1"].verdict == "not supported"
-        out.append(
-            f"NBO's regret is at most {fmt(c['DEC-1'].key.value, 2)} × J(u*)"
-            + (", zero up to rounding: NBO chooses the exact optimum" if exact else "")
-            + f" (DEC-1 {c['DEC-1'].verdict})."
-        )
-    zfam = z_families(summary)
-    parts = [
-        f"{fmt(zfam[cid].max_abs_z, 3)} of {zfam[cid].cells} {what} cells (limit "
-        f"{fmt(zfam[cid].limit, 3)}; {cid} {c[cid].verdict})"
-        for cid, what in (
-            ("DEC-2", "Monte-Carlo"),
-            ("DEC-3", "shared-draw tree"),
-            ("DEC-5", f"weighted, P ≥ {WEIGHTED_MIN_P},"),
-        )
-        if cid in c and cid in zfam
-    ]
-    if parts:
-        out.append("Simulated vs closed-form mean regret: max |z| " + ", ".join(parts) + ".")
-    fits = [
-        f"{range_text(s['slope'], signed=True)} for {what}"
-        for method, what in (("mc", "Monte Carlo"), ("sobol", "scrambled Sobol' points"))
-        if not (s := slopes(scaling, method)).empty
-    ]
-    if fits:
-        out.append("Log-log slopes of mean regret in P: " + ", ".join(fits) + ".")
-    if "DEC-4" in c:
-        d4 = c["DEC-4"]
-        shape = (
-            "rises again after its minimum over M in some cells (a U shape), so no slope "
-            "summarises it"
-            if d4.contrary
-            else "is summarised by its shape in M"
-        )
-        out.append(
-            f"The pruned tree's regret {shape}: {d4.key.name} = {fmt(d4.key.value, 3)} "
-            f"(DEC-4 {d4.verdict}; the regret at the smallest, the best and the largest M of "
-            "every cell is in its details)."
-        )
-    return " ".join(out)
+@dataclass(frozen=True)
+class KeyNumberText:
+    """A claim's key number for the findings: its name, its value (formatted), the claim's id
+    and verdict."""
+
+    id: str
+    name: str
+    value: str
+    verdict: str
 
 
-def _setting_paragraph(model: Mapping[str, Any], cfg: Mapping[str, Any]) -> str:
-    """The problem, the methods and the regret (first paragraph of the body)."""
-    a_txt = ", ".join(param_text(a) for a in cfg["a_values"])
-    h_txt = ", ".join(str(int(h)) for h in cfg["H_values"])
-    return (
-        "Does a method's cost estimate choose good controls? On the paper's scalar LQG, "
-        "x_{k+1} = (1 − a)x_k + a u_k + w_k, w_k ~ N(0, σ²), cost J(u) = E[r(x_H − T)² + "
-        f"Σ u_k²] (r = {param_text(model['r'])}, target T = {param_text(model['target'])}, "
-        f"x_0 = {param_text(model['x0'])}, σ = {param_text(model['sigma'])}; "
-        f"a ∈ {{{a_txt}}}, horizon H ∈ {{{h_txt}}} steps) each method draws its sample "
-        "once, its sample-average cost is minimised exactly over the open-loop controls "
-        "u_0..u_{H−1}, and the minimiser û is scored by its **regret** J(û) − J(u*) ≥ 0 "
-        "under the exact cost J, u* being the exact optimum; "
-        f"{int(cfg['replicates'])} replicates per stochastic cell (the cells of one method and "
-        "sample size share their draws across a and H, a cell of horizon H using the first "
-        "H steps: common random numbers, the cells' distributions unchanged). P = "
-        "trajectories an "
-        "estimate averages, N = draws per tree level (tree: P = N^H leaves), M = trajectories "
-        f"the pruned tree keeps (N = {int(cfg['pruned_N'])}); likeliness weights weight each "
-        "trajectory by the product of its noise densities."
+@dataclass(frozen=True)
+class ZFamily:
+    """A family of z-scores (simulated vs closed-form mean regret) for the findings: the
+    largest |z| of its cells, their number and their Bonferroni limit (formatted), the cells'
+    name and the claim judging them."""
+
+    max_abs_z: str
+    cells: str
+    limit: str
+    what: str
+    id: str
+    verdict: str
+
+
+@dataclass(frozen=True)
+class SlopeRange:
+    """The range of the log-log slopes of mean regret in P of one sample design."""
+
+    slopes: str
+    what: str
+
+
+def _key_text(claim: Claim, digits: int) -> KeyNumberText:
+    return KeyNumberText(
+        id=claim.id, name=claim.key.name, value=fmt(claim.key.value, digits), verdict=claim.verdict
     )
 
 
-#: why the regret has a closed form (second paragraph of the body)
-CLOSED_FORM_PARAGRAPH = (
-    "Why the answer has a closed form: J(u) = r[(m_H − T)² + v_H] + |u|², with m_H "
-    "and v_H the mean and variance of the final state, and v_H does not depend on u, "
-    "so NBO (noise at its mean) has J's minimiser. A sample average shifts the target "
-    "by the mean ē of the sampled final-state noises, giving regret κ ē², "
-    "κ = r²a²‖β‖²/(1 + r a²‖β‖²), β_k = (1 − a)^{H−1−k}: mean κ v_H / P for "
-    "independent trajectories, κ v_H / N (not / N^H) for the shared-draw tree, 0 for "
-    "antithetic pairs and symmetric cubature points. z = (simulated − closed-form "
-    "mean) / its standard error."
-)
+def _findings(
+    claims: Sequence[Claim], summary: pd.DataFrame, scaling: pd.DataFrame
+) -> dict[str, Any]:
+    """The values of the findings paragraph, every number from the claims and fits: DEC-1
+    (NBO's largest relative regret), the z-score families of DEC-2/3/5, the slope ranges, DEC-4
+    (the pruned tree's shape in M); each ``None`` or empty when absent."""
+    c = {claim.id: claim for claim in claims}
+    zfam = z_families(summary)
+    d1, d4 = c.get("DEC-1"), c.get("DEC-4")
+    return {
+        "dec1": _key_text(d1, 2) if d1 is not None else None,
+        "dec1_exact": d1 is not None and d1.verdict == "not supported",
+        "z_families": [
+            ZFamily(
+                max_abs_z=fmt(zfam[cid].max_abs_z, 3),
+                cells=str(zfam[cid].cells),
+                limit=fmt(zfam[cid].limit, 3),
+                what=what,
+                id=cid,
+                verdict=c[cid].verdict,
+            )
+            for cid, what in (
+                ("DEC-2", "Monte-Carlo"),
+                ("DEC-3", "shared-draw tree"),
+                ("DEC-5", f"weighted, P ≥ {WEIGHTED_MIN_P},"),
+            )
+            if cid in c and cid in zfam
+        ],
+        "slope_ranges": [
+            SlopeRange(slopes=range_text(s["slope"], signed=True), what=what)
+            for method, what in (("mc", "Monte Carlo"), ("sobol", "scrambled Sobol' points"))
+            if not (s := slopes(scaling, method)).empty
+        ],
+        "dec4": _key_text(d4, 3) if d4 is not None else None,
+        "dec4_u_shape": bool(d4 is not None and d4.contrary),
+    }
+
+
+def _setting(model: Mapping[str, Any], cfg: Mapping[str, Any]) -> dict[str, str]:
+    """The values of the setting paragraph: the LQG model (``lqg.model``) and the design
+    (``decisions.lqg``) as configured."""
+    return {
+        "r": param_text(model["r"]),
+        "target": param_text(model["target"]),
+        "x0": param_text(model["x0"]),
+        "sigma": param_text(model["sigma"]),
+        "a_set": "{" + ", ".join(param_text(a) for a in cfg["a_values"]) + "}",
+        "h_set": "{" + ", ".join(str(int(h)) for h in cfg["H_values"]) + "}",
+        "replicates": str(int(cfg["replicates"])),
+        "pruned_N": str(int(cfg["pruned_N"])),
+    }
 
 
 def _appendix(summary: pd.DataFrame, tables: Mapping[str, str]) -> str:
     """Derivations, the regret table at :func:`shown_a` and the slope table."""
-    return "\n".join(
-        [
-            "Derivations (`rsmhp.models.lqg.oven`): the regret of a cell with a closed form is "
-            "its mean times a χ²₁ variable, so the standard error of a mean of R replicates is "
-            "mean × √(2/R), and z = (simulated − closed form) / (closed form × √(2/R)); a "
-            "family of m z-scores is checked against the Bonferroni limit "
-            "Φ⁻¹(1 − 0.05/(2m)). With likeliness weights the self-normalised mean of the "
-            "final-state noise has variance (4/3)^{H/2} v_H / (3P) to first order in 1/P, "
-            "so weighting beats uniform mc for H ≤ 7. Sobol' uses the power of 2 nearest P.",
-            "",
-            f"Every cell at a = {param_text(shown_a(summary))} (R replicates; mean regret "
-            "with 95% t-interval; kind: exact, asymptotic (large P) or none). 'none' in the "
-            "closed-form column: no closed form for this method and weighting; 'none' in z: "
-            "no closed form, or it is 0 (nbo, antithetic, cubature: the simulated regret is "
-            f"rounding error, at most {fmt(max_rel_regret(summary, ZERO_REGRET), 2)} × J(u*)).",
-            "",
-            tables["dec_lqg_regret"],
-            "",
-            "Log-log slopes of mean regret in the sample size ('in': P, or N for the tree; M "
-            "= P for the pruned tree) with 95% t-intervals; (a, H) cells with fewer than 3 "
-            "sample sizes have no slope:",
-            "",
-            tables["dec_lqg_scaling"],
-        ]
+    return _render(
+        "section_lqg_appendix.md",
+        a_shown=param_text(shown_a(summary)),
+        zero_regret=fmt(max_rel_regret(summary, ZERO_REGRET), 2),
+        regret_table=tables["dec_lqg_regret"],
+        scaling_table=tables["dec_lqg_scaling"],
     )
 
 
@@ -204,21 +205,7 @@ def lqg_decision_section(
     tables and the closed-form derivation in the appendix. ``model`` is the ``lqg.model``
     config section, ``cfg`` the ``decisions.lqg`` one."""
     claims = lqg_claims(summary, scaling, model)
-    body = "\n".join(
-        [
-            _setting_paragraph(model, cfg),
-            "",
-            CLOSED_FORM_PARAGRAPH,
-            "",
-            _findings(claims, summary, scaling),
-            "",
-            "![LQG regret](figures/dec_lqg_regret.png)",
-            "",
-            "*Mean regret against P (log-log; tree: N^H leaves, pruned: M) per (a, H); "
-            "dashed: closed forms, dotted: likeliness weights. NBO, antithetic, cubature "
-            "(regret 0 up to rounding) not drawn.*",
-        ]
-    )
+    body = _render("section_lqg.md", **_setting(model, cfg), **_findings(claims, summary, scaling))
     return Section(
         key="decisions_lqg",
         title="Decision quality: LQG regret",

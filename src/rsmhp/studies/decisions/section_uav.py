@@ -1,11 +1,14 @@
 """Decision study on the UAV, report section (order 31): the Markdown tables of the open-loop
 regret and the sensitivity map, a short body (setting, findings, figures) and the appendix,
 assembled from :mod:`rsmhp.studies.decisions.summarise_uav` and the claims of
-:mod:`rsmhp.studies.decisions.claims_uav`."""
+:mod:`rsmhp.studies.decisions.claims_uav`. The prose is in the templates beside this module
+(``section_uav.md``: body, ``section_uav_appendix.md``); this module computes and formats the
+values they insert."""
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import pandas as pd
@@ -14,6 +17,7 @@ from rsmhp.models.uav.methods import baseline_name
 from rsmhp.report.ledger import Claim, Section
 from rsmhp.report.markdown import ci_cells, fmt, fmt_ci, markdown_table, param_text
 from rsmhp.report.palette import method_label
+from rsmhp.report.templates import render
 from rsmhp.studies.decisions.claims_uav import pp, uav_claims
 from rsmhp.studies.decisions.summarise_uav import (
     EARLY_STEP,
@@ -30,6 +34,12 @@ __all__ = ["FIGURES", "uav_decision_section", "uav_tables"]
 
 #: figure stems of the section (the figure rule writes them; see decisions.smk)
 FIGURES = ("dec_uav_regret", "dec_uav_map")
+
+
+def _render(template: str, **values: Any) -> str:
+    """The template ``template`` beside this module filled with ``values``, without the line
+    break that ends the template file."""
+    return render("rsmhp.studies.decisions", template, **values).removesuffix("\n")
 
 
 def _regret_table(summary: pd.DataFrame) -> str:
@@ -87,61 +97,110 @@ def uav_tables(summary: pd.DataFrame, map_df: pd.DataFrame) -> dict[str, str]:
     return {"dec_uav_regret": _regret_table(summary), "dec_uav_map": _map_table(map_df)}
 
 
-def _dec6_text(c: Claim, regret: pd.DataFrame, summary: pd.DataFrame, base: str | None) -> str:
+@dataclass(frozen=True)
+class Dec6:
+    """DEC-6 for the findings: NBO − the largest RS-MHP (``label``) in relative regret (pp,
+    formatted, with CI); NBO's mean relative regret and the part of it every method shares
+    (the common optimiser budget), both in percent, ``None`` without an NBO row."""
+
+    id: str
+    label: str
+    value: str
+    ci: str
+    verdict: str
+    nbo_regret: str | None
+    shared: str | None
+
+
+@dataclass(frozen=True)
+class Dec7:
+    """A DEC-7 claim of model variant ``model``: the relative-regret difference (pp, with CI)
+    and the belief states (of ``states``) where NBO's cost is constant over random plans
+    (``None`` when there are none)."""
+
+    id: str
+    model: str
+    value: str
+    ci: str
+    verdict: str
+    constant_states: str | None
+    states: str | None
+
+
+@dataclass(frozen=True)
+class Dec8:
+    """A DEC-8 claim: the map's closed-loop error of ``method`` − NBO (m, with CI), with
+    (``footprint``) or without a sensor footprint; ``contrary`` the evidence against it."""
+
+    id: str
+    footprint: bool
+    method: str
+    value: str
+    ci: str
+    verdict: str
+    contrary: str
+
+
+@dataclass(frozen=True)
+class Margin:
+    """The equivalence margin Δ (pp) against the share of regret every method loses to the
+    common optimiser budget (``share`` %, ``ratio`` = share / Δ; ``None`` without a base
+    model) and the lowest CI limit of the variants called better (``None`` if none is)."""
+
+    margin: str
+    share: str | None
+    ratio: str | None
+    lowest_better: str | None
+
+
+def _dec6(c: Claim, regret: pd.DataFrame, summary: pd.DataFrame, base: str | None) -> Dec6:
     best_rs = largest_rsmhp(summary)
-    label = method_label(best_rs) if best_rs else "RS-MHP"
     k = c.key
     nbo = summary[(summary["model"] == base) & (summary["method"] == baseline_name())]
-    shared = ""
-    if not nbo.empty:
-        shared = (
-            f"; of NBO's {fmt(pp(nbo['mean_regret_rel'].iloc[0]))}% mean relative regret, "
-            f"{fmt(pp(optimiser_share(regret, str(base))))}% is shared by every method, "
-            "the common optimiser budget"
-        )
-    return (
-        f"In the reconstruction the relative regret of NBO − {label} is "
-        f"{fmt(k.value, 2, True)} pp {fmt_ci(k.ci_low, k.ci_high, 2, True)}{shared} "
-        f"(DEC-6 {c.verdict})."
+    return Dec6(
+        id=c.id,
+        label=method_label(best_rs) if best_rs else "RS-MHP",
+        value=fmt(k.value, 2, True),
+        ci=fmt_ci(k.ci_low, k.ci_high, 2, True),
+        verdict=c.verdict,
+        nbo_regret=None if nbo.empty else fmt(pp(nbo["mean_regret_rel"].iloc[0])),
+        shared=None if nbo.empty else fmt(pp(optimiser_share(regret, str(base)))),
     )
 
 
-def _dec7_text(cid: str, c: Claim, summary: pd.DataFrame) -> str:
+def _dec7(cid: str, c: Claim, summary: pd.DataFrame) -> Dec7:
     k, model = c.key, cid[len("DEC-7-") :]
     s = summary[(summary["model"] == model) & (summary["method"] == baseline_name())]
-    flat = (
-        f"; NBO's single hypothesis makes its cost constant over random plans at "
-        f"{int(s['spearman_random_undefined'].iloc[0])} of {int(s['n_states'].iloc[0])} "
-        "states, where it cannot steer"
-        if not s.empty and int(s["spearman_random_undefined"].iloc[0]) > 0
-        else ""
-    )
-    return (
-        f"In '{model}' it is {fmt(k.value, 2, True)} pp "
-        f"{fmt_ci(k.ci_low, k.ci_high, 2, True)}{flat} ({cid} {c.verdict})."
+    flat = not s.empty and int(s["spearman_random_undefined"].iloc[0]) > 0
+    return Dec7(
+        id=cid,
+        model=model,
+        value=fmt(k.value, 2, True),
+        ci=fmt_ci(k.ci_low, k.ci_high, 2, True),
+        verdict=c.verdict,
+        constant_states=str(int(s["spearman_random_undefined"].iloc[0])) if flat else None,
+        states=str(int(s["n_states"].iloc[0])) if flat else None,
     )
 
 
-def _margin_text(margin: float, regret: pd.DataFrame, base: str | None, claims) -> str:
+def _margin(
+    margin: float, regret: pd.DataFrame, base: str | None, claims: Sequence[Claim]
+) -> Margin:
     """Why the equivalence margin of DEC-6/DEC-7 is what it is (numbers of this run)."""
-    out = (
-        f"The equivalence margin Δ = {param_text(margin)} pp (fixed in the config before the "
-        "run, decisions.claims.equivalence_margin_pp)"
+    share = (
+        pp(optimiser_share(regret, str(base)))
+        if base is not None and (regret["model"] == base).any()
+        else None
     )
-    if base is not None and (regret["model"] == base).any():
-        share = pp(optimiser_share(regret, str(base)))
-        out += f" is {fmt(share / margin, 2)}× smaller than the {fmt(share)}% every method loses "
-        out += "to the common optimiser budget"
     effects = [
         c.key.ci_low for c in claims if c.verdict == "supported" and c.id.startswith("DEC-7-")
     ]
-    if effects:
-        out += (
-            f", and below the lower CI limit of every variant called better "
-            f"({fmt(min(effects), 2)} pp): equivalence and 'better' are never said of effects "
-            "of one size"
-        )
-    return out + "."
+    return Margin(
+        margin=param_text(margin),
+        share=None if share is None else fmt(share),
+        ratio=None if share is None else fmt(share / margin, 2),
+        lowest_better=fmt(min(effects), 2) if effects else None,
+    )
 
 
 def _findings(
@@ -150,126 +209,96 @@ def _findings(
     summary: pd.DataFrame,
     base: str | None,
     margin: float,
-) -> str:
-    """One short paragraph of results, every number from the claims and the summary."""
+) -> dict[str, Any]:
+    """The values of the findings paragraph, every number from the claims and the summary:
+    DEC-6, the DEC-7 claims, DEC-8a/b, the margin (``None`` without DEC-6 and DEC-7)."""
     c = {cl.id: cl for cl in claims}
-    out = []
-    if "DEC-6" in c:
-        out.append(_dec6_text(c["DEC-6"], regret, summary, base))
-    out += [_dec7_text(cid, cl, summary) for cid, cl in c.items() if cid.startswith("DEC-7-")]
-    for cid, what in (("DEC-8a", "with a footprint"), ("DEC-8b", "without one")):
+    dec8 = []
+    for cid in ("DEC-8a", "DEC-8b"):
         if cid in c:
             k = c[cid].key
-            out.append(
-                f"On the map, {what}, the closed-loop error of {k.name.split(' − ')[0]} − NBO "
-                "averages "
-                f"{fmt(k.value, 3, True)} m {fmt_ci(k.ci_low, k.ci_high, 3, True)} "
-                f"({cid} {c[cid].verdict})."
-                + (f" Contrary: {c[cid].contrary}." if c[cid].contrary else "")
+            dec8.append(
+                Dec8(
+                    id=cid,
+                    footprint=cid == "DEC-8a",
+                    method=k.name.split(" − ")[0],
+                    value=fmt(k.value, 3, True),
+                    ci=fmt_ci(k.ci_low, k.ci_high, 3, True),
+                    verdict=c[cid].verdict,
+                    contrary=c[cid].contrary,
+                )
             )
-    if any(cid == "DEC-6" or cid.startswith("DEC-7-") for cid in c):
-        out.append(_margin_text(margin, regret, base, claims))
-    return " ".join(out)
+    judged = any(cid == "DEC-6" or cid.startswith("DEC-7-") for cid in c)
+    return {
+        "dec6": _dec6(c["DEC-6"], regret, summary, base) if "DEC-6" in c else None,
+        "dec7": [_dec7(cid, cl, summary) for cid, cl in c.items() if cid.startswith("DEC-7-")],
+        "dec8": dec8,
+        "margin": _margin(margin, regret, base, claims) if judged else None,
+    }
 
 
-def _variant_text(model: Mapping[str, Any]) -> str:
-    """``'footprint150' (footprint radius 150 m)``; the model without overrides is the
-    reconstruction."""
-    overrides = [
-        (f"{section}.{key}", value)
-        for section, values in model.items()
-        if section != "name"
-        for key, value in values.items()
-    ]
-    if not overrides:
-        return f"'{model['name']}' (the reconstruction)"
-    parts = []
-    for key, value in overrides:
-        name, unit = MAP_AXES.get(key, (key, ""))
-        parts.append(f"{name} {axis_value(key, value)}{' ' + unit if unit else ''}")
-    return f"'{model['name']}' ({', '.join(parts)})"
+@dataclass(frozen=True)
+class Variant:
+    """A model variant of the open-loop scoring: its name and its overrides of the
+    reconstruction, each as "name value unit" (none: the reconstruction)."""
+
+    name: str
+    overrides: list[str]
 
 
-def _setting(cfg: Mapping[str, Any]) -> list[str]:
-    """The body's two paragraphs on what was run: open-loop scoring and the map."""
+def _variant(model: Mapping[str, Any]) -> Variant:
+    """``Variant('footprint150', ['footprint radius 150 m'])`` for a ``decisions.uav.models``
+    entry."""
+    overrides = []
+    for section, values in model.items():
+        if section == "name":
+            continue
+        for key, value in values.items():
+            name, unit = MAP_AXES.get(f"{section}.{key}", (f"{section}.{key}", ""))
+            overrides.append(
+                f"{name} {axis_value(f'{section}.{key}', value)}{' ' + unit if unit else ''}"
+            )
+    return Variant(name=str(model["name"]), overrides=overrides)
+
+
+def _setting(cfg: Mapping[str, Any]) -> dict[str, Any]:
+    """The values of the body's two paragraphs on what was run: open-loop scoring and the
+    map."""
     ucfg, mcfg = cfg["uav"], cfg["map"]
     steps = [int(s) for s in ucfg["steps"]]
-    variants = "; ".join(_variant_text(m) for m in ucfg["models"])
     rk, ck = mcfg["rows"]["key"], mcfg["cols"]["key"]
-    rows_txt = ", ".join(axis_value(rk, v) for v in mcfg["rows"]["values"])
-    cols_txt = ", ".join(axis_value(ck, v) for v in mcfg["cols"]["values"])
-    return [
-        f"Open loop: at the belief states of {int(ucfg['runs'])} closed-loop NBO runs "
-        f"(steps {steps[0]} to {steps[-1]}; a belief state is the tracker's estimate and "
-        "covariance, step 0 the initial, most uncertain one) "
-        "every method plans once, as in the closed loop, and each plan is scored on "
-        f"{int(ucfg['n_eval'])} independent hypotheses drawn from the belief. **Relative "
-        "regret** = (evaluation cost of the plan − that of the best plan found) / best, "
-        "the best plan being the best of the methods' plans and of a multi-start "
-        "optimisation of the evaluation cost. Differences of relative regret are in "
-        "**percentage points (pp)**, paired per belief state, with 95% bootstrap CIs. N_T "
-        "= trajectories RS-MHP samples. Model variants (this project's, not the paper's): "
-        f"{variants}; a **footprint** is a horizontal radius (m) outside which the sensor "
-        "measures nothing.",
-        "",
-        f"Sensitivity map: {axis_label(rk)} ∈ {{{rows_txt}}} × {axis_label(ck)} ∈ "
-        f"{{{cols_txt}}}, {int(mcfg['runs'])} paired closed-loop runs per method and cell "
-        "(the same scenarios and noise in every cell); **track loss** = final location "
-        f"error above {param_text(mcfg['track_loss_error'])} m.",
-    ]
-
-
-_FIGURE_TEXT = [
-    "![UAV open-loop regret](figures/dec_uav_regret.png)",
-    "",
-    "*Relative regret per belief state and method (log scale; values below "
-    f"{REGRET_FLOOR_TEXT} drawn at {REGRET_FLOOR_TEXT}, counted in each panel); "
-    "bottom: against the best of the methods' "
-    "plans only.*",
-    "",
-    "![UAV sensitivity map](figures/dec_uav_map.png)",
-    "",
-    "*Closed-loop method − NBO average location error (m) per map cell, one panel per "
-    "method (RS-MHP, each family at the planning budget); * marks a 95% CI excluding 0; "
-    "track-loss rates NBO/method; colours span ±max |difference|, nothing clipped.*",
-]
+    return {
+        "runs": str(int(ucfg["runs"])),
+        "first_step": str(steps[0]),
+        "last_step": str(steps[-1]),
+        "n_eval": str(int(ucfg["n_eval"])),
+        "variants": [_variant(m) for m in ucfg["models"]],
+        "row_label": axis_label(rk),
+        "row_set": "{" + ", ".join(axis_value(rk, v) for v in mcfg["rows"]["values"]) + "}",
+        "col_label": axis_label(ck),
+        "col_set": "{" + ", ".join(axis_value(ck, v) for v in mcfg["cols"]["values"]) + "}",
+        "map_runs": str(int(mcfg["runs"])),
+        "track_loss_error": param_text(mcfg["track_loss_error"]),
+        "regret_floor": REGRET_FLOOR_TEXT,
+    }
 
 
 def _appendix(cfg: Mapping[str, Any], tables: Mapping[str, str]) -> str:
     ucfg, mcfg = cfg["uav"], cfg["map"]
-    steps = [int(s) for s in ucfg["steps"]]
-    return "\n".join(
-        [
-            f"Scoring (`decisions.uav`): steps {', '.join(str(s) for s in steps)} of runs 0 to "
-            f"{int(ucfg['runs']) - 1}; the best plan found polishes the "
-            f"{int(ucfg['polish'])} best plans and {int(ucfg['random_starts'])} random starts "
-            f"with the planner's optimiser ({int(ucfg['eval_maxiter'])} iterations) on the "
-            "evaluation cost. "
-            "The standard error (SE) of a regret is paired over the evaluation hypotheses; "
-            "'vs best method' isolates the part due to the cost approximation (the rest is "
-            "the common optimiser budget stopping early). Spearman: rank correlation of the "
-            f"method's cost with the evaluation cost over {int(ucfg['n_random'])} random plans "
-            "('constant cost': states where the method's cost does not change over them, so "
-            "the correlation is undefined and left out of the mean) or over local "
-            "perturbations. A footprint has a hard edge in the truth; the planner uses the "
-            "detection probability 1/(1 + exp((ρ − radius)/w)) at horizontal distance ρ and "
-            "the expected update P⁺ = P⁻ − p_d K S Kᵀ (`rsmhp.models.uav.sensor`).",
-            "",
-            "Open-loop relative regret per model and method (percent of the best plan's cost; "
-            f"CI: 95% bootstrap over belief states; early: steps ≤ {EARLY_STEP}):",
-            "",
-            tables["dec_uav_regret"],
-            "",
-            "Sensitivity map: mean paired difference of the closed-loop average location "
-            f"error, method − NBO (m), over {int(mcfg['runs'])} runs; p: Wilcoxon signed-rank "
-            "test ('undefined' if every difference is 0); track loss, detection rate and "
-            f"open-loop relative regret (at the belief states of {int(mcfg['regret_runs'])} "
-            f"NBO runs, steps {', '.join(str(int(s)) for s in mcfg['regret_steps'])}) in "
-            "percent; 'unlimited': no footprint (the reconstruction's sensor); 'undefined' "
-            "in a regret column: the cell has no open-loop regret states.",
-            "",
-            tables["dec_uav_map"],
-        ]
+    return _render(
+        "section_uav_appendix.md",
+        steps=", ".join(str(int(s)) for s in ucfg["steps"]),
+        last_run=str(int(ucfg["runs"]) - 1),
+        polish=str(int(ucfg["polish"])),
+        random_starts=str(int(ucfg["random_starts"])),
+        eval_maxiter=str(int(ucfg["eval_maxiter"])),
+        n_random=str(int(ucfg["n_random"])),
+        early_step=str(EARLY_STEP),
+        regret_table=tables["dec_uav_regret"],
+        map_runs=str(int(mcfg["runs"])),
+        regret_runs=str(int(mcfg["regret_runs"])),
+        regret_steps=", ".join(str(int(s)) for s in mcfg["regret_steps"]),
+        map_table=tables["dec_uav_map"],
     )
 
 
@@ -289,10 +318,12 @@ def uav_decision_section(
     n_boot = int(cfg["map"]["bootstrap"])
     claims = uav_claims(regret, summary, map_df, groups, cfg["claims"], seed, n_boot, base_limited)
     base = base_model(list(dict.fromkeys(regret["model"])))
-    findings = _findings(
-        claims, regret, summary, base, float(cfg["claims"]["equivalence_margin_pp"])
+    margin = float(cfg["claims"]["equivalence_margin_pp"])
+    body = _render(
+        "section_uav.md",
+        **_setting(cfg),
+        **_findings(claims, regret, summary, base, margin),
     )
-    body = "\n".join([*_setting(cfg), "", findings, "", *_FIGURE_TEXT])
     return Section(
         key="decisions_uav",
         title="Decision quality: UAV open-loop regret and sensitivity map",
