@@ -110,8 +110,6 @@ rule all:
         rules.uav.input,
         rules.decisions.input,
         rules.frontier.input,
-        rules.frontier_exploratory.input
-        if config["decisions"]["frontier"]["exploratory"]
-        else [],
+        rules.frontier_exploratory.input if config["frontier"]["exploratory"] else [],
         rules.horizon.input,
         rules.report.output,

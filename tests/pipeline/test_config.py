@@ -168,18 +168,18 @@ def test_bad_uav_values_are_named(path, value, expected):
         ("decisions.map.regret_steps", [70], r"decisions\.map\.regret_steps: \[70\]"),
         ("decisions.map.track_loss_error", 0, r"decisions\.map\.track_loss_error: 0 "),
         ("decisions.map.bootstrap", 10, r"decisions\.map\.bootstrap: 10 "),
-        ("decisions.recording.model", "nothere", r"decisions\.recording\.model: 'nothere'"),
-        ("decisions.recording.select", "first", r"decisions\.recording\.select: 'first'"),
-        ("decisions.frontier.budget.ms_per_step", 0, r"frontier\.budget\.ms_per_step: 0 "),
-        ("decisions.frontier.claims.margin_pp", -0.1, r"frontier\.claims\.margin_pp: -0\.1 "),
-        ("decisions.frontier.timing.steps", [0, 70], r"frontier\.timing\.steps: \[70\]"),
+        ("frontier.recording.model", "nothere", r"frontier\.recording\.model: 'nothere'"),
+        ("frontier.recording.select", "first", r"frontier\.recording\.select: 'first'"),
+        ("frontier.budget.ms_per_step", 0, r"frontier\.budget\.ms_per_step: 0 "),
+        ("frontier.claims.margin_pp", -0.1, r"frontier\.claims\.margin_pp: -0\.1 "),
+        ("frontier.timing.steps", [0, 70], r"frontier\.timing\.steps: \[70\]"),
         (
-            "decisions.frontier.tuning.timing.steps",
+            "frontier.tuning.timing.steps",
             [99],
             r"frontier\.tuning\.timing\.steps: \[99\]",
         ),
-        ("decisions.frontier.tuning.budgets_ms", [0], r"tuning\.budgets_ms\[0\]: 0 "),
-        ("decisions.frontier.tuning.runs", 1, r"tuning\.runs: 1 "),
+        ("frontier.tuning.budgets_ms", [0], r"tuning\.budgets_ms\[0\]: 0 "),
+        ("frontier.tuning.runs", 1, r"tuning\.runs: 1 "),
         ("horizon.stream", "judge", r"horizon\.stream: 'judge'"),
     ],
 )
@@ -348,7 +348,7 @@ def test_merge_follows_snakemakes_overlay_rule():
 
 
 def test_the_exploratory_frontier_needs_two_regret_runs():
-    cfg = _with("decisions.frontier.exploratory", True)
-    cfg["decisions"]["frontier"]["regret_runs"] = 1
+    cfg = _with("frontier.exploratory", True)
+    cfg["frontier"]["regret_runs"] = 1
     with pytest.raises(ConfigError, match=r"frontier\.regret_runs: 1 \(allowed: at least 2"):
         check_config(cfg)

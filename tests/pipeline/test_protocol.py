@@ -423,7 +423,7 @@ def test_confirm_section_reads_its_numbers_from_the_tables():
                     "preregistration": {"sha256": "e" * 64, "commit": "d" * 40},
                     "claims": [{"id": "FR-2-y", "key": {"value": 2.0, "unit": "m"},
                                 "verdict": "inconclusive"}]}))  # fmt: skip
-    assert sec.key == "decisions_frontier" and len(sec.claims) == 3
+    assert sec.key == "frontier" and len(sec.claims) == 3
     assert "sha256 eeeeeeeeeeee, commit dddddddddd; superseded, not counted" in sec.appendix
     assert "FR-2-y" in sec.appendix and "budgeted on medians." in sec.appendix
     # what the members at the claims' budget spent in closed loop (2 ms: all within it)
@@ -433,7 +433,7 @@ def test_confirm_section_reads_its_numbers_from_the_tables():
     for c in claims:
         assert f"{c.id}" in sec.body
     assert "FR-1-x" in sec.appendix and "76a0c01" in sec.appendix
-    assert "(no tuned configurations)" in tables["dec_confirm_tuning"]
+    assert "(no tuned configurations)" in tables["frontier_confirm_tuning"]
 
 
 def _git(cwd, *args):

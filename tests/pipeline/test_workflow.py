@@ -215,12 +215,12 @@ def test_estimator_study_outputs(run_j2, tiny):
         assert len(raw) == row["n_replicates"]
         assert row["mean"] == pytest.approx(raw["estimate"].mean())
     for name in (
-        "est_rmse_vs_n",
-        "est_bias_vs_n",
-        "est_tree_variance",
-        "est_weighted_vs_uniform",
-        "est_pruning_heatmap",
-        "est_frontier",
+        "estimators_rmse_vs_n",
+        "estimators_bias_vs_n",
+        "estimators_tree_variance",
+        "estimators_weighted_vs_uniform",
+        "estimators_pruning_heatmap",
+        "estimators_frontier",
     ):
         assert (run_j2 / f"results/figures/{name}.png").read_bytes()[:4] == b"\x89PNG"
         assert (run_j2 / f"results/paper/figures/{name}.png").exists()
@@ -319,8 +319,8 @@ def test_decision_study_outputs(run_j2, tiny, tmp_path):
     report = (run_j2 / "results/paper/replication.md").read_text()
     for cid in ("DEC-1", "DEC-2", "DEC-3"):
         assert f"| {cid} |" in report
-    assert "](figures/dec_lqg_regret.png)" in report
-    assert (run_j2 / "results/paper/figures/dec_lqg_regret.png").exists()
+    assert "](figures/decisions_lqg_regret.png)" in report
+    assert (run_j2 / "results/paper/figures/decisions_lqg_regret.png").exists()
     # one worker gives the same file (seeds keyed on the cell and replicate, not the worker)
     res = snakemake(tmp_path, "-j1", "results/decisions/lqg_regret.csv")
     assert res.returncode == 0, res.stderr[-3000:]
@@ -332,17 +332,17 @@ def test_decision_study_outputs(run_j2, tiny, tmp_path):
 def test_frontier_outputs(run_j2, tiny):
     """The equal-compute study runs in the default target: one job per model, every method's
     paired runs with its planning time, the summary and the figure."""
-    cfg = tiny["decisions"]["frontier"]
+    cfg = tiny["frontier"]
     names = ["nbo", "rsmhp_nt8", "rqmc_nt8", "sigma", "dpw_s20"]
     for model in cfg["models"]:
-        runs = pd.read_csv(run_j2 / f"results/decisions/frontier/{model}.csv")
+        runs = pd.read_csv(run_j2 / f"results/frontier/explore/{model}.csv")
         assert list(dict.fromkeys(runs["method"])) == names
         assert len(runs) == len(names) * cfg["runs"] and (runs["plan_ms"] > 0).all()
-        assert (run_j2 / f"results/benchmarks/decisions_frontier/{model}.tsv").exists()
-    summary = pd.read_csv(run_j2 / "results/decisions/frontier_summary.csv")
+        assert (run_j2 / f"results/benchmarks/frontier_explore/{model}.tsv").exists()
+    summary = pd.read_csv(run_j2 / "results/frontier/explore_summary.csv")
     assert len(summary) == len(names) * len(cfg["models"])
     assert (summary.loc[summary["method"] == "nbo", "error_diff"] == 0).all()
-    png = (run_j2 / "results/figures/dec_frontier.png").read_bytes()
+    png = (run_j2 / "results/figures/frontier_exploratory.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
     # in the report: section, claims FR-1..3 per model, figure, both tables
     report = (run_j2 / "results/paper/replication.md").read_text()
@@ -350,9 +350,9 @@ def test_frontier_outputs(run_j2, tiny):
     for model in cfg["models"]:
         for k in (1, 2, 3):
             assert f"| FR-{k}-{model} |" in report
-    assert (run_j2 / "results/paper/figures/dec_frontier.png").exists()
+    assert (run_j2 / "results/paper/figures/frontier_exploratory.png").exists()
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
-    for table in ("dec_frontier", "dec_frontier_budget"):
+    for table in ("frontier_exploratory", "frontier_budget"):
         text = (run_j2 / f"results/tables/{table}.md").read_text()
         assert text.strip() and text.strip() in appendix
     # the exploratory design (tiny: exploratory: true) has its section, never claims
@@ -371,24 +371,24 @@ def test_confirm_outputs(run_j2, tiny):
         tuned_configurations,
     )
 
-    cfg = tiny["decisions"]["frontier"]["confirm"]
+    cfg = tiny["frontier"]["confirm"]
     pre = Preregistration.load(ROOT / cfg["preregistration"], ROOT / cfg["tuned"])
     tuned = yaml.safe_load((ROOT / cfg["tuned"]).read_text())
     for model in pre.doc["models"]:
-        runs = pd.read_csv(run_j2 / f"results/decisions/confirm/{model}.csv")
+        runs = pd.read_csv(run_j2 / f"results/frontier/confirm/{model}.csv")
         want = {c.name for c in pre.configurations(tuned, model)}
         assert set(runs["config"]) == want and len(runs) == len(want) * pre.runs(model)
-        timing = pd.read_csv(run_j2 / f"results/decisions/confirm/timing/{model}.csv")
+        timing = pd.read_csv(run_j2 / f"results/frontier/confirm/timing/{model}.csv")
         assert set(timing["config"]) == want and (timing["ms"] > 0).all()
         # the confirm stream: NBO's runs are not the exploratory frontier's (another seed)
-        explo = pd.read_csv(run_j2 / f"results/decisions/frontier/{model}.csv")
+        explo = pd.read_csv(run_j2 / f"results/frontier/explore/{model}.csv")
         nbo_c = runs[runs["config"] == "nbo"].set_index("run")["mean_error"]
         nbo_e = explo[explo["method"] == "nbo"].set_index("run")["mean_error"]
         common = nbo_c.index.intersection(nbo_e.index)
         assert len(common) and (nbo_c[common] != nbo_e[common]).all()
         assert stream_seed(tiny["seed"], "confirm") != tiny["seed"]
         per = tuned_configurations(tuned, model)
-        lad = pd.read_csv(run_j2 / "results/decisions/confirm_ladder.csv")
+        lad = pd.read_csv(run_j2 / "results/frontier/confirm_ladder.csv")
         assert len(lad[lad["model"] == model]) == sum(
             len(per.get(f"{float(b):g}", {})) for b in pre.doc["budgets_ms"]
         )
@@ -400,10 +400,10 @@ def test_confirm_outputs(run_j2, tiny):
     assert all(c["key"]["p_value"] is not None and c["key"]["p_holm"] is not None for c in fr)
     report = (run_j2 / "results/paper/replication.md").read_text()
     assert "## Planners at equal compute (confirmatory)" in report
-    assert "](figures/dec_confirm.png)" in report
+    assert "](figures/frontier_confirm.png)" in report
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
     assert "76a0c01" in appendix
-    for table in ("dec_confirm", "dec_confirm_ladder", "dec_confirm_tuning"):
+    for table in ("frontier_confirm", "frontier_confirm_ladder", "frontier_confirm_tuning"):
         assert (run_j2 / f"results/tables/{table}.md").read_text().strip() in appendix
 
 
@@ -426,16 +426,16 @@ def test_horizon_outputs(run_j2, tiny):
     for model in cfg["models"]:
         for cid in (f"HZ-1-{model}", f"HZ-2-{model}", f"HZ-3-{model}"):
             assert f"| {cid} |" in report
-    for name in ("hz_uav_error", "hz_uav_time", "hz_uav_closed"):
+    for name in ("horizon_uav_error", "horizon_uav_time", "horizon_uav_closed"):
         assert (run_j2 / f"results/paper/figures/{name}.png").read_bytes()[:4] == b"\x89PNG"
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
-    for table in ("hz_uav_approx", "hz_uav_regret", "hz_uav_closed", "hz_lqg",
-                  "hz_lqg_estimators", "hz_lqg_regret"):  # fmt: skip
+    for table in ("horizon_uav_approx", "horizon_uav_regret", "horizon_uav_closed", "horizon_lqg",
+                  "horizon_lqg_estimators", "horizon_lqg_regret"):  # fmt: skip
         assert (run_j2 / f"results/tables/{table}.md").read_text().strip() in appendix
     # the N_T ∝ H member has 2 H hypotheses at every H (tiny: rsmhp_nt_per_step [2])
     assert "rsmhp_nt2h" in set(summary["method"])
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
-    assert "Runs needed (closed loop; table hz_uav_closed" in appendix
+    assert "Runs needed (closed loop; table horizon_uav_closed" in appendix
 
 
 def test_scenarios_outputs(run_j2, tiny):
@@ -453,10 +453,12 @@ def test_scenarios_outputs(run_j2, tiny):
     assert (summary["low"] <= summary["p_improve"]).all()
     report = (run_j2 / "results/paper/replication.md").read_text()
     assert report.index("## Optimiser error apart") < report.index("## Across scenarios")
-    assert "](figures/scn_improvement.png)" in report
-    assert (run_j2 / "results/paper/figures/scn_improvement.png").read_bytes()[:4] == b"\x89PNG"
+    assert "](figures/scenarios_improvement.png)" in report
+    assert (run_j2 / "results/paper/figures/scenarios_improvement.png").read_bytes()[
+        :4
+    ] == b"\x89PNG"
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
-    for table in ("scn_improvement", "scn_per_scenario"):
+    for table in ("scenarios_improvement", "scenarios_per_scenario"):
         assert (run_j2 / f"results/tables/{table}.md").read_text().strip() in appendix
 
 
@@ -474,7 +476,7 @@ def test_horizon_lqg_outputs(run_j2, tiny):
     report = (run_j2 / "results/paper/replication.md").read_text()
     for cid in ("HZ-4", "HZ-5"):
         assert f"| {cid} |" in report
-    assert (run_j2 / "results/paper/figures/hz_lqg.png").read_bytes()[:4] == b"\x89PNG"
+    assert (run_j2 / "results/paper/figures/horizon_lqg.png").read_bytes()[:4] == b"\x89PNG"
 
 
 def test_horizon_recording_replays_the_run_its_rule_chooses(run_j2, tiny):
@@ -506,23 +508,23 @@ def test_horizon_recording_replays_the_run_its_rule_chooses(run_j2, tiny):
 
 
 def test_frontier_recording_replays_the_run_its_rule_chooses(run_j2, tiny):
-    """decisions.recording: NBO and every budget member, in the run chosen by `select` from
+    """frontier.recording: NBO and every budget member, in the run chosen by `select` from
     the frontier's paired differences (the log says which; the replay equals the table)."""
     from rsmhp.studies.frontier.summarise import select_run
 
-    rec, fr = tiny["decisions"]["recording"], tiny["decisions"]["frontier"]
-    runs = pd.read_csv(run_j2 / f"results/decisions/frontier/{rec['model']}.csv")
+    rec, fr = tiny["frontier"]["recording"], tiny["frontier"]
+    runs = pd.read_csv(run_j2 / f"results/frontier/explore/{rec['model']}.csv")
     run, d = select_run(runs, rec["model"], "rsmhp_nt8", "nbo", rec["select"])
-    log = (run_j2 / "results/logs/decisions_frontier_recording.log").read_text()
+    log = (run_j2 / "results/logs/frontier_recording.log").read_text()
     assert f"run {run} ({rec['select']} of rsmhp_nt8 − nbo: d = {d:+.3f} m)" in log
-    path = run_j2 / f"results/recordings/dec_{rec['model']}_planners.rrd"
+    path = run_j2 / f"results/recordings/frontier_{rec['model']}_planners.rrd"
     entities = set()
     for chunk in RrdReader(path).store().stream():
         entities.add(str(chunk.entity_path))
     for m in ["nbo", *fr["budget"]["members"]]:
         assert f"/{m}/map/uav_path" in entities and f"/error/{m}" in entities
     assert "/about" in entities
-    assert not list((run_j2 / "results/recordings").glob("dec_*_run*.rrd"))
+    assert not list((run_j2 / "results/recordings").glob("frontier_*_run*.rrd"))
 
 
 def test_uav_decision_outputs(run_j2, tiny):
@@ -547,7 +549,7 @@ def test_uav_decision_outputs(run_j2, tiny):
     report = (run_j2 / "results/paper/replication.md").read_text()
     for cid in ("DEC-6", "DEC-8a", "DEC-8b"):
         assert f"| {cid} |" in report
-    for name in ("dec_uav_regret", "dec_uav_map"):
+    for name in ("decisions_uav_regret", "decisions_uav_map"):
         assert (run_j2 / f"results/paper/figures/{name}.png").exists()
 
 

@@ -20,7 +20,7 @@ PRIORITY = {
     "holds_cores": 2000,
     "estimators_ablation": 1000,
     "decisions_uav": 990,
-    "decisions_frontier": 980,
+    "frontier": 980,
     "horizon_uav": 970,
     "horizon_lqg": 960,
     "estimators_summary": 100,

@@ -54,7 +54,9 @@ rule decisions_lqg_summary:
     output:
         summary="results/decisions/lqg_summary.csv",
         scaling="results/decisions/lqg_scaling.csv",
-        tables=table_outputs(["dec_lqg_regret", "dec_lqg_scaling"], "Decision study"),
+        tables=table_outputs(
+            ["decisions_lqg_regret", "decisions_lqg_scaling"], "Decision study"
+        ),
         section="results/report/decisions_lqg.json",
     log:
         "results/logs/decisions_lqg_summary.log",
@@ -145,7 +147,9 @@ rule decisions_uav_summary:
         regret_summary="results/decisions/uav_regret_summary.csv",
         map="results/decisions/uav_map.csv",
         map_groups="results/decisions/uav_map_groups.csv",
-        tables=table_outputs(["dec_uav_regret", "dec_uav_map"], "Decision study"),
+        tables=table_outputs(
+            ["decisions_uav_regret", "decisions_uav_map"], "Decision study"
+        ),
         section="results/report/decisions_uav.json",
     log:
         "results/logs/decisions_uav_summary.log",

@@ -3,20 +3,20 @@
 # figures and recording are separate rules.
 
 EST_TABLES = [
-    "est_largest",
-    "est_tree_vs_independent",
-    "est_pruning",
-    "est_equal_cpu",
-    "est_chebyshev",
-    "est_weighted",
+    "estimators_largest",
+    "estimators_tree_vs_independent",
+    "estimators_pruning",
+    "estimators_equal_cpu",
+    "estimators_chebyshev",
+    "estimators_weighted",
 ]
 EST_FIGURES = [
-    "est_rmse_vs_n",
-    "est_bias_vs_n",
-    "est_tree_variance",
-    "est_weighted_vs_uniform",
-    "est_pruning_heatmap",
-    "est_frontier",
+    "estimators_rmse_vs_n",
+    "estimators_bias_vs_n",
+    "estimators_tree_variance",
+    "estimators_weighted_vs_uniform",
+    "estimators_pruning_heatmap",
+    "estimators_frontier",
 ]
 REPORT_SECTIONS["estimators"] = "results/report/estimators.json"
 REPORT_FIGURES.extend(EST_FIGURES)

@@ -1,4 +1,4 @@
-# Equal-compute study of the planners (decisions.frontier): one job per model variant with
+# Equal-compute study of the planners (frontier): one job per model variant with
 # paired closed-loop runs and open-loop regret of every method and its planning time per step
 # (one thread: the time is the study's measure of compute), then aggregation and the figure.
 import json
@@ -9,22 +9,20 @@ from rsmhp.studies.frontier.section import CONFIRM_TABLES
 from rsmhp.studies.frontier.section import TABLES as FRONTIER_TABLES
 from rsmhp.pipeline.protocol import confirm_plan
 
-FRONTIER = config["decisions"]["frontier"]
-FRONTIER_FAMILIES = families_of(FRONTIER["methods"], "decisions.frontier.methods")
+FRONTIER = config["frontier"]
+FRONTIER_FAMILIES = families_of(FRONTIER["methods"], "frontier.methods")
 FRONTIER_MODELS = list(FRONTIER["models"])
-FRONTIER_REC = config["decisions"]["recording"]
-FRONTIER_RECORDING = f"results/recordings/dec_{FRONTIER_REC['model']}_planners.rrd"
+FRONTIER_REC = config["frontier"]["recording"]
+FRONTIER_RECORDING = f"results/recordings/frontier_{FRONTIER_REC['model']}_planners.rrd"
 # the exploratory design (published up to 76a0c01): only on request, as a section without claims
 if FRONTIER_MODELS and FRONTIER["exploratory"]:
-    REPORT_SECTIONS["decisions_frontier_exploratory"] = (
-        "results/report/decisions_frontier.json"
-    )
+    REPORT_SECTIONS["frontier_exploratory"] = "results/report/frontier_exploratory.json"
     REPORT_FIGURES.extend(FRONTIER_FIGURES)
 # the confirmatory run: what the committed preregistration and tuned file name (checked here,
 # before any job: a tuned file that is not the preregistered one stops the workflow)
 CONFIRM = confirm_plan(workflow.basedir, FRONTIER)
 if CONFIRM is not None:
-    REPORT_SECTIONS["decisions_frontier"] = "results/report/decisions_confirm.json"
+    REPORT_SECTIONS["frontier"] = "results/report/frontier.json"
     REPORT_FIGURES.extend(CONFIRM_FIGURES)
 
 
@@ -32,16 +30,16 @@ wildcard_constraints:
     model=r"[a-z][a-z0-9_]*",
 
 
-rule decisions_frontier:
+rule frontier_explore:
     """Equal-compute study, one model variant: closed- and open-loop quality and planning time of every method."""
     output:
-        runs="results/decisions/frontier/{model}.csv",
-        regret="results/decisions/frontier/{model}_regret.csv",
+        runs="results/frontier/explore/{model}.csv",
+        regret="results/frontier/explore/{model}_regret.csv",
     log:
-        "results/logs/decisions_frontier/{model}.log",
+        "results/logs/frontier_explore/{model}.log",
     benchmark:
-        "results/benchmarks/decisions_frontier/{model}.tsv"
-    priority: PRIORITY["decisions_frontier"]
+        "results/benchmarks/frontier_explore/{model}.tsv"
+    priority: PRIORITY["frontier"]
     conda:
         ENV
     threads: 1
@@ -62,19 +60,19 @@ rule decisions_frontier:
         scoring=DEC_SCORING,
         seed=config["seed"],
         families=FRONTIER_FAMILIES,
-        code=code_digest("workflow/scripts/decisions_frontier.py", FRONTIER_FAMILIES),
+        code=code_digest("workflow/scripts/frontier_explore.py", FRONTIER_FAMILIES),
     script:
-        "../scripts/decisions_frontier.py"
+        "../scripts/frontier_explore.py"
 
 
-rule decisions_frontier_timing:
+rule frontier_explore_timing:
     """Equal-compute study, one model variant: interleaved wall-clock timing of every method's plan call (holds the cores)."""
     output:
-        "results/decisions/frontier/timing/{model}.csv",
+        "results/frontier/explore/timing/{model}.csv",
     log:
-        "results/logs/decisions_frontier_timing/{model}.log",
+        "results/logs/frontier_explore_timing/{model}.log",
     benchmark:
-        "results/benchmarks/decisions_frontier_timing/{model}.tsv"
+        "results/benchmarks/frontier_explore_timing/{model}.tsv"
     priority: PRIORITY["holds_cores"]
     conda:
         ENV
@@ -91,30 +89,30 @@ rule decisions_frontier_timing:
         seed=config["seed"],
         families=FRONTIER_FAMILIES,
         code=code_digest(
-            "workflow/scripts/decisions_frontier_timing.py", FRONTIER_FAMILIES
+            "workflow/scripts/frontier_explore_timing.py", FRONTIER_FAMILIES
         ),
     script:
-        "../scripts/decisions_frontier_timing.py"
+        "../scripts/frontier_explore_timing.py"
 
 
-rule decisions_frontier_summary:
+rule frontier_explore_summary:
     """Equal-compute study: per model and method, compute and quality with bootstrap CIs."""
     input:
-        runs=expand("results/decisions/frontier/{model}.csv", model=FRONTIER_MODELS),
+        runs=expand("results/frontier/explore/{model}.csv", model=FRONTIER_MODELS),
         regret=expand(
-            "results/decisions/frontier/{model}_regret.csv", model=FRONTIER_MODELS
+            "results/frontier/explore/{model}_regret.csv", model=FRONTIER_MODELS
         ),
         timing=expand(
-            "results/decisions/frontier/timing/{model}.csv", model=FRONTIER_MODELS
+            "results/frontier/explore/timing/{model}.csv", model=FRONTIER_MODELS
         ),
     output:
-        summary="results/decisions/frontier_summary.csv",
-        tables=table_outputs(FRONTIER_TABLES, "Decision study"),
-        section="results/report/decisions_frontier.json",
+        summary="results/frontier/explore_summary.csv",
+        tables=table_outputs(FRONTIER_TABLES, "Equal compute"),
+        section="results/report/frontier_exploratory.json",
     log:
-        "results/logs/decisions_frontier_summary.log",
+        "results/logs/frontier_explore_summary.log",
     benchmark:
-        "results/benchmarks/decisions_frontier_summary.tsv"
+        "results/benchmarks/frontier_explore_summary.tsv"
     conda:
         ENV
     threads: 1
@@ -125,21 +123,21 @@ rule decisions_frontier_summary:
         cfg=canonical(FRONTIER),
         horizon=config["uav"]["planner"]["horizon"],
         seed=config["seed"],
-        code=code_digest("workflow/scripts/decisions_frontier_summary.py"),
+        code=code_digest("workflow/scripts/frontier_explore_summary.py"),
     script:
-        "../scripts/decisions_frontier_summary.py"
+        "../scripts/frontier_explore_summary.py"
 
 
-rule decisions_frontier_figures:
+rule frontier_explore_figures:
     """Equal-compute study figure: quality against planning time, one curve per family."""
     input:
-        summary="results/decisions/frontier_summary.csv",
+        summary="results/frontier/explore_summary.csv",
     output:
-        figure_outputs(FRONTIER_FIGURES, "Decision study"),
+        figure_outputs(FRONTIER_FIGURES, "Equal compute"),
     log:
-        "results/logs/decisions_frontier_figures.log",
+        "results/logs/frontier_explore_figures.log",
     benchmark:
-        "results/benchmarks/decisions_frontier_figures.tsv"
+        "results/benchmarks/frontier_explore_figures.tsv"
     conda:
         ENV
     threads: 1
@@ -148,21 +146,21 @@ rule decisions_frontier_figures:
         runtime=5,
     params:
         budget=canonical(FRONTIER["budget"]),
-        code=code_digest("workflow/scripts/decisions_frontier_figures.py"),
+        code=code_digest("workflow/scripts/frontier_explore_figures.py"),
     script:
-        "../scripts/decisions_frontier_figures.py"
+        "../scripts/frontier_explore_figures.py"
 
 
-rule decisions_frontier_recording:
-    """Rerun recording of one frontier run (chosen by decisions.recording.select): NBO and every family's budget member."""
+rule frontier_recording:
+    """Rerun recording of one frontier run (chosen by frontier.recording.select): NBO and every family's budget member."""
     input:
-        runs=f"results/decisions/frontier/{FRONTIER_REC['model']}.csv",
+        runs=f"results/frontier/explore/{FRONTIER_REC['model']}.csv",
     output:
         FRONTIER_RECORDING,
     log:
-        "results/logs/decisions_frontier_recording.log",
+        "results/logs/frontier_recording.log",
     benchmark:
-        "results/benchmarks/decisions_frontier_recording.tsv"
+        "results/benchmarks/frontier_recording.tsv"
     conda:
         ENV
     threads: 1
@@ -176,24 +174,22 @@ rule decisions_frontier_recording:
         recording=canonical(FRONTIER_REC),
         seed=config["seed"],
         families=FRONTIER_FAMILIES,
-        code=code_digest(
-            "workflow/scripts/decisions_frontier_recording.py", FRONTIER_FAMILIES
-        ),
+        code=code_digest("workflow/scripts/frontier_recording.py", FRONTIER_FAMILIES),
     script:
-        "../scripts/decisions_frontier_recording.py"
+        "../scripts/frontier_recording.py"
 
 
 rule frontier_exploratory:
     """Target: the exploratory equal-compute design published up to 76a0c01 (tables, section, figure, recording)."""
     input:
-        rules.decisions_frontier_summary.output if FRONTIER_MODELS else [],
-        rules.decisions_frontier_figures.output if FRONTIER_MODELS else [],
-        rules.decisions_frontier_recording.output if FRONTIER_MODELS else [],
+        rules.frontier_explore_summary.output if FRONTIER_MODELS else [],
+        rules.frontier_explore_figures.output if FRONTIER_MODELS else [],
+        rules.frontier_recording.output if FRONTIER_MODELS else [],
 
 
 # ---------------------------------------------------------------------------- the protocol
 # Tuning (target `tune`, `make tune`; not part of the default run): every candidate of
-# decisions.frontier.tuning in closed loop and in an interleaved timing on the tuning stream,
+# frontier.tuning in closed loop and in an interleaved timing on the tuning stream,
 # then the selection rule (rsmhp.pipeline.protocol.select) writes results/tune/tuned.yaml.
 TUNING = FRONTIER["tuning"]
 
@@ -206,7 +202,7 @@ rule frontier_tune:
         "results/logs/frontier_tune/{model}.log",
     benchmark:
         "results/benchmarks/frontier_tune/{model}.tsv"
-    priority: PRIORITY["decisions_frontier"]
+    priority: PRIORITY["frontier"]
     conda:
         ENV
     threads: 1
@@ -302,12 +298,12 @@ with open(
 rule frontier_confirm:
     """Protocol, confirmatory run, one model variant: closed-loop runs of the preregistered configurations on the confirm stream."""
     output:
-        "results/decisions/confirm/{model}.csv",
+        "results/frontier/confirm/{model}.csv",
     log:
         "results/logs/frontier_confirm/{model}.log",
     benchmark:
         "results/benchmarks/frontier_confirm/{model}.tsv"
-    priority: PRIORITY["decisions_frontier"]
+    priority: PRIORITY["frontier"]
     conda:
         ENV
     threads: 1
@@ -331,7 +327,7 @@ rule frontier_confirm:
 rule frontier_confirm_timing:
     """Protocol, confirmatory run, one model variant: interleaved timing of the preregistered configurations (holds the cores)."""
     output:
-        "results/decisions/confirm/timing/{model}.csv",
+        "results/frontier/confirm/timing/{model}.csv",
     log:
         "results/logs/frontier_confirm_timing/{model}.log",
     benchmark:
@@ -362,15 +358,15 @@ rule frontier_confirm_timing:
 rule frontier_confirm_summary:
     """Protocol, confirmatory run: per configuration and budget, compute and quality with CIs, claims FR-*, tables and the report section."""
     input:
-        runs=expand("results/decisions/confirm/{model}.csv", model=CONFIRM_MODELS),
+        runs=expand("results/frontier/confirm/{model}.csv", model=CONFIRM_MODELS),
         timing=expand(
-            "results/decisions/confirm/timing/{model}.csv", model=CONFIRM_MODELS
+            "results/frontier/confirm/timing/{model}.csv", model=CONFIRM_MODELS
         ),
     output:
-        summary="results/decisions/confirm_summary.csv",
-        ladder="results/decisions/confirm_ladder.csv",
-        tables=table_outputs(CONFIRM_TABLES, "Decision study"),
-        section="results/report/decisions_confirm.json",
+        summary="results/frontier/confirm_summary.csv",
+        ladder="results/frontier/confirm_ladder.csv",
+        tables=table_outputs(CONFIRM_TABLES, "Equal compute"),
+        section="results/report/frontier.json",
     log:
         "results/logs/frontier_confirm_summary.log",
     conda:
@@ -393,9 +389,9 @@ rule frontier_confirm_summary:
 rule frontier_confirm_figures:
     """Protocol, confirmatory run: the ladder figure (error against both compute units, probability of improvement)."""
     input:
-        ladder="results/decisions/confirm_ladder.csv",
+        ladder="results/frontier/confirm_ladder.csv",
     output:
-        figure_outputs(CONFIRM_FIGURES, "Decision study"),
+        figure_outputs(CONFIRM_FIGURES, "Equal compute"),
     log:
         "results/logs/frontier_confirm_figures.log",
     conda:

@@ -11,4 +11,4 @@ from rsmhp.studies.frontier.summarise import LADDER_COLUMNS
 with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent
     lad = read_table(snakemake.input.ladder, LADDER_COLUMNS)
-    save_figure(confirm_figure(lad), outdir / "dec_confirm")
+    save_figure(confirm_figure(lad), outdir / "frontier_confirm")

@@ -11,4 +11,4 @@ from rsmhp.studies.horizon.section_optimiser import SUMMARY_COLUMNS
 with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent
     summary = read_table(snakemake.input[0], SUMMARY_COLUMNS)
-    save_figure(optimiser_figure(summary), outdir / "hz_optimiser")
+    save_figure(optimiser_figure(summary), outdir / "horizon_optimiser")

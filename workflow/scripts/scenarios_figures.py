@@ -12,4 +12,4 @@ from rsmhp.studies.scenarios.summarise import SUMMARY_COLUMNS
 with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent
     summary = read_table(snakemake.input[0], SUMMARY_COLUMNS)
-    save_figure(improvement_figure(summary), outdir / "scn_improvement")
+    save_figure(improvement_figure(summary), outdir / "scenarios_improvement")

@@ -271,18 +271,18 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
     problems: list[str] = []
     dec = config.get("decisions", {}) or {}
     n_steps = ((config.get("uav", {}) or {}).get("scenario", {}) or {}).get("steps", 60)
-    fr = dec.get("frontier", {}) or {}
+    fr = config.get("frontier", {}) or {}
     for path, steps in (
         ("decisions.uav.steps", (dec.get("uav", {}) or {}).get("steps", [])),
         ("decisions.map.regret_steps", (dec.get("map", {}) or {}).get("regret_steps", [])),
-        ("decisions.frontier.regret_steps", fr.get("regret_steps", [])),
-        ("decisions.frontier.timing.steps", (fr.get("timing", {}) or {}).get("steps", [])),
+        ("frontier.regret_steps", fr.get("regret_steps", [])),
+        ("frontier.timing.steps", (fr.get("timing", {}) or {}).get("steps", [])),
         (
-            "decisions.frontier.tuning.timing.steps",
+            "frontier.tuning.timing.steps",
             ((fr.get("tuning", {}) or {}).get("timing", {}) or {}).get("steps", [0, 7, 20]),
         ),
         (
-            "decisions.frontier.confirm.timing.steps",
+            "frontier.confirm.timing.steps",
             ((fr.get("confirm", {}) or {}).get("timing", {}) or {}).get("steps", [0, 7, 20]),
         ),
     ):
@@ -295,49 +295,53 @@ def _decisions_cross_field(config: Mapping[str, Any]) -> list[str]:
     rr = fr.get("regret_runs", 10)
     if fr.get("exploratory") and isinstance(rr, int) and rr < 2:
         problems.append(
-            f"decisions.frontier.regret_runs: {rr} (allowed: at least 2 with "
-            "decisions.frontier.exploratory: true: its open-loop CIs are over runs)"
+            f"frontier.regret_runs: {rr} (allowed: at least 2 with "
+            "frontier.exploratory: true: its open-loop CIs are over runs)"
         )
     names = [m.get("name") for m in (dec.get("uav", {}) or {}).get("models", []) or []]
     dup = sorted({n for n in names if names.count(n) > 1})
     if dup:
         problems.append(f"decisions.uav.models: duplicate name(s) {dup} (allowed: unique names)")
     base = uav_methods.baseline()
-    for section in ("uav", "map", "frontier"):
-        methods = (dec.get(section, {}) or {}).get("methods")
+    for section, block in (
+        ("decisions.uav", dec.get("uav")),
+        ("decisions.map", dec.get("map")),
+        ("frontier", fr),
+    ):
+        methods = (block or {}).get("methods")
         if isinstance(methods, Mapping) and methods:
             n = uav_methods.count(methods)
             if not methods.get(base.config_key, base.default):
                 problems.append(
-                    f"decisions.{section}.methods.{base.config_key}: "
+                    f"{section}.methods.{base.config_key}: "
                     f"{str(methods.get(base.config_key)).lower()} (allowed: true; "
                     f"{base.family_label} is "
                     "the baseline every comparison of the decision study is made against)"
                 )
-            if n < 2 and section == "map":
+            if n < 2 and section == "decisions.map":
                 problems.append(
                     "decisions.map.methods: fewer than 2 methods (allowed: NBO and at least "
                     "one RS-MHP N_T or tree, to compare)"
                 )
             if n < 1:
-                problems.append(f"decisions.{section}.methods: no method (allowed: at least 1)")
+                problems.append(f"{section}.methods: no method (allowed: at least 1)")
             problems += uav_methods.config_problems(
-                methods, f"decisions.{section}.methods", config.get("uav", {}) or {}
+                methods, f"{section}.methods", config.get("uav", {}) or {}
             )
     unknown = [m for m in fr.get("models", []) or [] if names and m not in names]
     if unknown:
         problems.append(
-            f"decisions.frontier.models: {unknown} not model(s) of decisions.uav.models "
+            f"frontier.models: {unknown} not model(s) of decisions.uav.models "
             f"(allowed: {', '.join(map(str, names))})"
         )
     fr_models = [m for m in fr.get("models", []) or [] if isinstance(m, str)]
-    rec = (dec.get("recording", {}) or {}).get("model")
+    rec = (fr.get("recording", {}) or {}).get("model")
     if rec is not None and fr_models and rec not in fr_models:
         problems.append(
-            f"decisions.recording.model: {rec!r} is not a model of decisions.frontier.models "
+            f"frontier.recording.model: {rec!r} is not a model of frontier.models "
             f"(allowed: {', '.join(fr_models)}; the recording replays one of its runs)"
         )
-    problems += _budget_problems(dec, bool(fr_models))
+    problems += _budget_problems(dec, fr, bool(fr_models))
     problems += _horizon_problems(config, names, n_steps)
     mp = dec.get("map", {}) or {}
     claim_method = (dec.get("claims", {}) or {}).get("map_method") or ""
@@ -492,15 +496,16 @@ def _member_names(methods: Any) -> dict[str, Any]:
         return {}
 
 
-def _budget_problems(dec: Mapping[str, Any], frontier_runs: bool) -> list[str]:
-    """``decisions.frontier.budget.members``: methods of the frontier, one per non-baseline
+def _budget_problems(
+    dec: Mapping[str, Any], fr: Mapping[str, Any], frontier_runs: bool
+) -> list[str]:
+    """``frontier.budget.members``: methods of the frontier, one per non-baseline
     family and one for each such family of the frontier, all run by the map;
-    ``decisions.frontier.claims.sigma_reference``: a Monte-Carlo member of the frontier."""
-    fr = dec.get("frontier", {}) or {}
+    ``frontier.claims.sigma_reference``: a Monte-Carlo member of the frontier."""
     if not frontier_runs:
         return []
     problems: list[str] = []
-    path = "decisions.frontier.budget.members"
+    path = "frontier.budget.members"
     members = list(((fr.get("budget", {}) or {}).get("members", [])) or [])
     run = _member_names(fr.get("methods"))
     if not run:
@@ -508,7 +513,7 @@ def _budget_problems(dec: Mapping[str, Any], frontier_runs: bool) -> list[str]:
     unknown = [m for m in members if m not in run]
     if unknown:
         problems.append(
-            f"{path}: {unknown} not method(s) of decisions.frontier.methods "
+            f"{path}: {unknown} not method(s) of frontier.methods "
             f"(allowed: {', '.join(n for n, m in run.items() if not m.baseline)})"
         )
     fams: dict[str, list[str]] = {}
@@ -525,7 +530,7 @@ def _budget_problems(dec: Mapping[str, Any], frontier_runs: bool) -> list[str]:
     if missing:
         problems.append(
             f"{path}: no member of the frontier's famil(ies) {missing} (allowed: one member "
-            "of every family decisions.frontier.methods runs)"
+            "of every family frontier.methods runs)"
         )
     map_run = _member_names((dec.get("map", {}) or {}).get("methods"))
     absent = [m for m in members if m in run and map_run and m not in map_run]
@@ -538,8 +543,8 @@ def _budget_problems(dec: Mapping[str, Any], frontier_runs: bool) -> list[str]:
     mc = [n for n, m in run.items() if isinstance(m, MonteCarlo)]
     if ref is not None and mc and ref not in mc:
         problems.append(
-            f"decisions.frontier.claims.sigma_reference: {ref!r} is not a Monte-Carlo member "
-            f"of decisions.frontier.methods (allowed: {', '.join(mc)})"
+            f"frontier.claims.sigma_reference: {ref!r} is not a Monte-Carlo member "
+            f"of frontier.methods (allowed: {', '.join(mc)})"
         )
     return problems
 

@@ -167,19 +167,19 @@ class Configuration:
 
 def tuning_configurations(tuning: Mapping[str, Any]) -> list[Configuration]:
     """Everything the tuning runs: the baseline (as the tables' reference, not tuned), then
-    :func:`candidates` of ``tuning["candidates"]`` (``decisions.frontier.tuning``)."""
+    :func:`candidates` of ``tuning["candidates"]`` (``frontier.tuning``)."""
     return [Configuration(methods.baseline()().name), *candidates(tuning["candidates"])]
 
 
 def candidates(cfg: Mapping[str, Any]) -> list[Configuration]:
-    """The tuning candidates of ``decisions.frontier.tuning.candidates``: every member of its
+    """The tuning candidates of ``frontier.tuning.candidates``: every member of its
     ``methods`` block; a sampled-cost member once per (maxiter, restarts) of ``optimiser``, a
     tree search as it is (its budget is its simulations and constants). The baseline family
     is left out (it is not tuned). Table order, then maxiter, then restarts."""
     block = cfg["methods"]
     opt = cfg["optimiser"]
     out: list[Configuration] = []
-    for m in methods.from_config(block, "decisions.frontier.tuning.candidates.methods").values():
+    for m in methods.from_config(block, "frontier.tuning.candidates.methods").values():
         if m.baseline:
             continue
         if m.estimates_cost:
@@ -453,10 +453,10 @@ def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, 
     preregistration (content, path, sha256; the commit that added it is looked up by the
     rule when it runs, :func:`file_commit`, so that a copy of the workflow outside git does
     not rerun anything), the tuned file (content, sha256), and
-    per model its runs and configurations; ``None`` when ``decisions.frontier`` has no model
+    per model its runs and configurations; ``None`` when ``frontier`` has no model
     or the preregistration file does not exist (the report then has no FR claims). A
     preregistration that does not fit the tuned file, or names a model outside
-    ``decisions.frontier.models``, is refused naming both."""
+    ``frontier.models``, is refused naming both."""
     if not frontier.get("models"):
         return None
     conf = frontier["confirm"]
@@ -470,7 +470,7 @@ def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, 
     if outside:
         raise ValueError(
             f"preregistration {conf['preregistration']}: models {outside} are not in "
-            f"decisions.frontier.models ({list(frontier['models'])})"
+            f"frontier.models ({list(frontier['models'])})"
         )
     models = list(pre.doc["models"])
     return {

@@ -752,12 +752,15 @@ def test_section_budget_and_text():
     # configuration values print as written (r = 10, a = 0.4), not 10.0 or 0.400
     assert "r = 10," in section.body and "0.400" not in section.body
     assert not re.search(r"(?<![\d.])\d+\.0(?![\d])", section.body)
-    for table in (tables["dec_lqg_regret"], tables["dec_lqg_scaling"]):
+    for table in (tables["decisions_lqg_regret"], tables["decisions_lqg_scaling"]):
         assert table in section.appendix
         assert not NAN_INF.search(table) and not WHOLE_FLOAT_CELL.search(table)
     # absent closed forms are words, explained next to the table
-    assert "| none" in tables["dec_lqg_regret"] and "'none' in the closed-form" in section.appendix
-    assert re.search(r"\|\s+400 \|", tables["dec_lqg_regret"])  # replicates as an integer
+    assert (
+        "| none" in tables["decisions_lqg_regret"]
+        and "'none' in the closed-form" in section.appendix
+    )
+    assert re.search(r"\|\s+400 \|", tables["decisions_lqg_regret"])  # replicates as an integer
 
 
 def test_claims_fit_the_ledger():

@@ -535,10 +535,10 @@ def test_section_budget_and_text():
         assert table in section.appendix
         assert not NAN_INF.search(table) and not WHOLE_FLOAT_CELL.search(table)
     # the unlimited footprint and the undefined values are words, explained in the appendix
-    assert "| unlimited" in tables["dec_uav_map"] and "'unlimited'" in section.appendix
-    assert "undefined" in tables["dec_uav_regret"]  # NBO's constant cost in fp150
-    assert "undefined" in tables["dec_uav_map"]  # no open-loop regret states in these cells
-    assert re.search(r"\|\s+40 \|", tables["dec_uav_map"])  # runs as an integer
+    assert "| unlimited" in tables["decisions_uav_map"] and "'unlimited'" in section.appendix
+    assert "undefined" in tables["decisions_uav_regret"]  # NBO's constant cost in fp150
+    assert "undefined" in tables["decisions_uav_map"]  # no open-loop regret states in these cells
+    assert re.search(r"\|\s+40 \|", tables["decisions_uav_map"])  # runs as an integer
 
 
 def test_claims_fit_the_ledger():

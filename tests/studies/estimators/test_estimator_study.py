@@ -439,7 +439,7 @@ def test_section_body_budget_and_clean_numbers(section):
         assert len(c.claim) <= CLAIM_MAX and len(c.paper) <= PAPER_MAX, c.id
         assert len(c.rule) <= RULE_MAX, c.id
     # the Chebyshev table of the appendix: the exact probability beside the bound, largest n
-    rows = _table_cells(tabs["est_chebyshev"])
+    rows = _table_cells(tabs["estimators_chebyshev"])
     assert len(rows) == 2 * len(KS) and {r["n"] for r in rows} == {"64"}
     assert all(float(r["exact"]) < float(r["bound 1/k²"]) for r in rows)
     assert "the exact probability (a generalised chi-square) lies at" in sec.body

@@ -169,7 +169,7 @@ def test_bad_frontier_config_is_refused_naming_the_fields():
     from rsmhp.pipeline.config import ConfigError, check_config
 
     cfg = copy.deepcopy(CONFIG)
-    fr = cfg["decisions"]["frontier"]
+    fr = cfg["frontier"]
     fr["models"] = ["paper", "nowhere"]
     fr["methods"]["nbo"] = False
     fr["methods"]["rqmc_nt"] = [16, 48]
@@ -177,12 +177,12 @@ def test_bad_frontier_config_is_refused_naming_the_fields():
     with pytest.raises(ConfigError) as err:
         check_config(cfg)
     msg = str(err.value)
-    assert "decisions.frontier.models: ['nowhere'] not model(s) of decisions.uav.models" in msg
-    assert "decisions.frontier.methods.nbo: false (allowed: true" in msg
-    assert "decisions.frontier.methods.rqmc_nt[1]: 48 is not a power of 2" in msg
-    assert "decisions.frontier.regret_steps: [60] not before the run's last step" in msg
+    assert "frontier.models: ['nowhere'] not model(s) of decisions.uav.models" in msg
+    assert "frontier.methods.nbo: false (allowed: true" in msg
+    assert "frontier.methods.rqmc_nt[1]: 48 is not a power of 2" in msg
+    assert "frontier.regret_steps: [60] not before the run's last step" in msg
     ok = copy.deepcopy(CONFIG)
-    ok["decisions"]["frontier"]["models"] = []  # no model: the study does not run
+    ok["frontier"]["models"] = []  # no model: the study does not run
     check_config(ok)
 
 

@@ -162,7 +162,7 @@ def test_select_run_by_each_rule():
     assert select_run(runs, "m", "a", "nbo", "nearest_median") == (2, -1.0)  # tie: lowest run
     assert select_run(runs, "m", "a", "nbo", "largest_gain") == (5, -20.0)
     assert select_run(runs, "m", "a", "nbo", "largest_loss") == (3, 3.0)
-    with pytest.raises(ValueError, match=re.escape("decisions.recording.select: 'first'")):
+    with pytest.raises(ValueError, match=re.escape("frontier.recording.select: 'first'")):
         select_run(runs, "m", "a", "nbo", "first")
     with pytest.raises(ValueError, match="'b' has no runs"):
         select_run(runs, "m", "b", "nbo", "nearest_mean")
@@ -232,7 +232,7 @@ def test_missing_members_drop_their_claims_only():
     assert set(claims) == {"FR-3-m"}  # FR-1 needs RQMC, FR-2 the sigma points
     cfg = _cfg()
     del cfg["claims"]
-    with pytest.raises(ValueError, match=re.escape("decisions.frontier lacks 'claims'")):
+    with pytest.raises(ValueError, match=re.escape("frontier lacks 'claims'")):
         _claims(cfg)
 
 
@@ -246,17 +246,14 @@ def test_exploratory_section_states_every_comparison_and_the_budget():
     tables = frontier_tables(summary, cfg)
     sec = frontier_section(FrontierInputs(runs, regret, summary, tables, cfg, seed=11, horizon=6))
     # the exploratory design: its comparisons are printed, never claims of the ledger
-    assert sec.key == "decisions_frontier_exploratory" and sec.claims == []
+    assert sec.key == "frontier_exploratory" and sec.claims == []
     assert "Exploratory comparisons (not claims)" in sec.body
     for c in _claims().values():
         k = c.key
         assert f"'m' {fmt(k.value, k.digits, True)}" in sec.body and f"({c.verdict})" in sec.body
     assert "56 equally weighted cubature points" in sec.appendix  # 8 (H + 1), H = 6
     assert "nan" not in sec.body.lower() and "nan" not in sec.appendix.lower()
-    assert (
-        "| RQMC N_T=16 " in tables["dec_frontier_budget"]
-        and "| no " in tables["dec_frontier_budget"]
-    )
+    assert "| RQMC N_T=16 " in tables["frontier_budget"] and "| no " in tables["frontier_budget"]
 
 
 # ------------------------------------------------------------------------ config checks
@@ -267,12 +264,11 @@ def test_exploratory_section_states_every_comparison_and_the_budget():
     [
         (
             lambda fr, dec: fr["budget"].update(members=["rsmhp_nt16", "rqmc_nt999"]),
-            "decisions.frontier.budget.members: ['rqmc_nt999'] not method(s) of "
-            "decisions.frontier.methods",
+            "frontier.budget.members: ['rqmc_nt999'] not method(s) of frontier.methods",
         ),
         (
             lambda fr, dec: fr["budget"]["members"].append("nbo"),
-            "decisions.frontier.budget.members: ['nbo'] is the baseline",
+            "frontier.budget.members: ['nbo'] is the baseline",
         ),
         (
             lambda fr, dec: fr["budget"]["members"].append("rsmhp_nt64"),
@@ -288,11 +284,11 @@ def test_exploratory_section_states_every_comparison_and_the_budget():
         ),
         (
             lambda fr, dec: fr["claims"].update(sigma_reference="rqmc_nt256"),
-            "decisions.frontier.claims.sigma_reference: 'rqmc_nt256' is not a Monte-Carlo member",
+            "frontier.claims.sigma_reference: 'rqmc_nt256' is not a Monte-Carlo member",
         ),
         (
-            lambda fr, dec: dec["recording"].update(model="paper2"),
-            "decisions.recording.model: 'paper2' is not a model of decisions.frontier.models",
+            lambda fr, dec: fr["recording"].update(model="paper2"),
+            "frontier.recording.model: 'paper2' is not a model of frontier.models",
         ),
     ],
 )
@@ -300,8 +296,7 @@ def test_bad_budget_config_is_refused_naming_the_field(edit, expected):
     from rsmhp.pipeline.config import ConfigError, check_config
 
     cfg = copy.deepcopy(CONFIG)
-    dec = cfg["decisions"]
-    edit(dec["frontier"], dec)
+    edit(cfg["frontier"], cfg["decisions"])
     with pytest.raises(ConfigError) as err:
         check_config(cfg)
     assert expected in str(err.value)
@@ -326,9 +321,9 @@ def test_recording_setup_shows_nbo_and_every_budget_member():
     from rsmhp.studies.frontier.simulate import recording_setup
 
     dec = CONFIG["decisions"]
-    fr = dec["frontier"]
+    fr = CONFIG["frontier"]
     setup, methods = recording_setup(CONFIG["uav"], dec["uav"]["models"], fr, "footprint150")
     assert [m.name for m in methods] == ["nbo", *fr["budget"]["members"]]
     assert setup.sensor.limited
-    with pytest.raises(ValueError, match=re.escape("decisions.recording.model: 'nowhere'")):
+    with pytest.raises(ValueError, match=re.escape("frontier.recording.model: 'nowhere'")):
         recording_setup(CONFIG["uav"], dec["uav"]["models"], fr, "nowhere")

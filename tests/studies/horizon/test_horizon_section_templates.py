@@ -242,11 +242,11 @@ def test_horizon_section_templates_are_complete(inputs, calls):
     # every paragraph of the body and of the appendix is reached by the data
     for words in ("Claims HZ-1-m", "At H = 24 on 'm'", "runs at uav.planner's budget (maxiter 30",
                   "At H = 24 and maxiter 30", "CIs of HZ-1-m", "Oven LQG (closed forms, a = 0.50)",
-                  "figures/hz_lqg.png"):  # fmt: skip
+                  "figures/horizon_lqg.png"):  # fmt: skip
         assert words in s.body, words
     for words in ("Runs needed", "Pruned tree, N = 4", "Decisions: uniform Monte Carlo",
-                  "|z| > 3 in 2 of 4 cells", "Intervals of the claims", inputs.tables["hz_lqg"],
-                  "eps = 0.010 of L_1"):  # fmt: skip
+                  "|z| > 3 in 2 of 4 cells", "Intervals of the claims",
+                  inputs.tables["horizon_lqg"], "eps = 0.010 of L_1"):  # fmt: skip
         assert words in s.appendix, words
     assert s.body.split("\n\n")[0].startswith("H ∈ {4, 24} on 'm', belief states of 12 NBO")
 
@@ -261,7 +261,7 @@ def test_horizon_section_without_the_optional_inputs(inputs, calls):
     _check_calls(calls)
     _check_text(s.body, s.appendix)
     assert s.appendix.startswith("\n\n\n\nCost approximation per model")
-    assert "hz_lqg.png" not in s.body and s.body.endswith("by horizon.*\n")
+    assert "horizon_lqg.png" not in s.body and s.body.endswith("by horizon.*\n")
     assert "runs at uav.planner's budget, the same for every method" in s.body
     assert "is in section 'Optimiser error apart from approximation error'." in s.body
 

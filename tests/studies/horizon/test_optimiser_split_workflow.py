@@ -129,7 +129,7 @@ def test_section_numbers_come_from_the_split_rows(table, summary):
     section = optimiser_section(summary, optimiser_tables(summary), CFG, PLANNER)
     body = section.body
     assert (section.key, section.title, section.order) == (KEY, TITLE, ORDER)
-    assert ORDER == 34 and section.claims == [] and section.figures == ["hz_optimiser"]
+    assert ORDER == 34 and section.claims == [] and section.figures == ["horizon_optimiser"]
     assert not re.search(r"\b(nan|inf)\b", body + section.appendix, re.IGNORECASE)
     cells = table.groupby(["model", "H", "method", "maxiter", "restarts"], sort=False)
     means = 100 * cells[["regret", "approx_regret", "optim_regret"]].mean()
@@ -230,7 +230,7 @@ def test_figure_draws_on_a_synthetic_summary(summary, tmp_path):
     labels = [t.get_text() for t in fig.axes[-1].get_legend().get_texts()]
     assert "total, maxiter 30 (default)" in labels and "approximation part" in labels
     assert "total, maxiter 1000 + 8 restarts" in labels
-    png, pdf = save_figure(fig, tmp_path / "hz_optimiser")
+    png, pdf = save_figure(fig, tmp_path / "horizon_optimiser")
     assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and pdf.read_bytes()[:5] == b"%PDF-"
     with pytest.raises(ValueError, match="empty"):
         optimiser_figure(summary.iloc[:0])
@@ -335,7 +335,7 @@ def test_tiny_run_of_the_new_rules(tmp_path):
     tiny = yaml.safe_load(TINY.read_text())
     opt = tiny["horizon"]["optimiser"]
     res = _snakemake(tmp_path, "-j2", "results/report/horizon_optimiser.json",
-                     "results/figures/hz_optimiser.png")  # fmt: skip
+                     "results/figures/horizon_optimiser.png")  # fmt: skip
     assert res.returncode == 0, (res.stdout + res.stderr)[-3000:]
     cfg = {**CONFIG["horizon"]["optimiser"], **opt, "methods": {
         **CONFIG["horizon"]["optimiser"]["methods"], **opt["methods"]}}  # fmt: skip
@@ -358,7 +358,7 @@ def test_tiny_run_of_the_new_rules(tmp_path):
     for h in opt["H"]:
         g = d[d["H"] == h]
         assert f"H = {h}: R {_pct(g['regret_pct'])}, A {_pct(g['approx_pct'])}" in section["body"]
-    assert (tmp_path / "results/tables/hz_optimiser.md").read_text().startswith("| model")
-    png = (tmp_path / "results/figures/hz_optimiser.png").read_bytes()
+    assert (tmp_path / "results/tables/horizon_optimiser.md").read_text().startswith("| model")
+    png = (tmp_path / "results/figures/horizon_optimiser.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
     assert "done in" in (tmp_path / "results/logs/horizon_optimiser_summary.log").read_text()

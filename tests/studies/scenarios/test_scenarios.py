@@ -162,7 +162,7 @@ def test_section_and_figure_read_the_summary():
     assert f"{HORIZON_GROUP} (3, 2 methods)" in sec.body
     top = s[s.group == HORIZON_GROUP].sort_values("p_improve").iloc[-1]  # the highest
     assert f"{fmt(top.p_improve, 2)} [{fmt(top.low, 2)}, {fmt(top.high, 2)}]" in sec.body
-    assert tables["scn_improvement"] in sec.appendix
+    assert tables["scenarios_improvement"] in sec.appendix
     fig = improvement_figure(s)
     try:
         assert fig.axes[0].get_xlabel().startswith("P(run beats NBO")

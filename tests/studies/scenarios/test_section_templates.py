@@ -76,8 +76,8 @@ def test_the_prose_is_complete(data):
     )
     assert sec.body.endswith("bars: 95% stratified bootstrap.*")
     assert sec.appendix.startswith("A scenario is a map cell (decision study, H = 6, its stream)")
-    assert sec.appendix.endswith(tables["scn_per_scenario"])
-    assert f"\n\n{tables['scn_improvement']}\n\nPer scenario:\n\n" in sec.appendix
+    assert sec.appendix.endswith(tables["scenarios_per_scenario"])
+    assert f"\n\n{tables['scenarios_improvement']}\n\nPer scenario:\n\n" in sec.appendix
     # a group with one method names it once; no data: one sentence
     one = section.scenarios_section(summary.groupby("group").head(1), tables)
     assert f"{MAP_GROUP} (2): " in one.body and "highest" not in one.body

@@ -480,7 +480,7 @@ def variant(models: list[Mapping[str, Any]], name: str) -> Mapping[str, Any]:
     found = {m["name"]: m for m in models}
     if name not in found:
         raise ValueError(
-            f"decisions.frontier.models: {name!r} is not a model of decisions.uav.models "
+            f"frontier.models: {name!r} is not a model of decisions.uav.models "
             f"(allowed: {', '.join(found)})"
         )
     return found[name]

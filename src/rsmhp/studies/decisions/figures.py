@@ -153,7 +153,7 @@ def lqg_regret_figure(summary: pd.DataFrame) -> plt.Figure:
 
 def _jitter(n: int, key: str) -> np.ndarray:
     """Deterministic horizontal jitter in [-0.25, 0.25] for ``n`` points."""
-    return job_rng(0, "figure", figure="dec_uav_regret", key=key).uniform(-0.25, 0.25, n)
+    return job_rng(0, "figure", figure="decisions_uav_regret", key=key).uniform(-0.25, 0.25, n)
 
 
 def uav_regret_figure(regret: pd.DataFrame) -> plt.Figure:

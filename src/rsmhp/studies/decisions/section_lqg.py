@@ -29,7 +29,7 @@ from rsmhp.studies.decisions.claims_lqg import lqg_claims
 __all__ = ["FIGURES", "lqg_decision_section", "lqg_tables", "shown_a"]
 
 #: figure stems of the section (the figure rule writes them; see decisions.smk)
-FIGURES = ("dec_lqg_regret",)
+FIGURES = ("decisions_lqg_regret",)
 
 
 def _render(template: str, **values: Any) -> str:
@@ -59,8 +59,8 @@ def shown_a(summary: pd.DataFrame) -> float:
 def lqg_tables(
     summary: pd.DataFrame, scaling: pd.DataFrame, a_show: float | None = None
 ) -> dict[str, str]:
-    """Markdown tables keyed by file stem: ``dec_lqg_regret`` (every cell at ``a_show``,
-    default :func:`shown_a`), ``dec_lqg_scaling`` (every slope fit). Absent closed forms and
+    """Markdown tables keyed by file stem: ``decisions_lqg_regret`` (every cell at ``a_show``,
+    default :func:`shown_a`), ``decisions_lqg_scaling`` (every slope fit). Absent closed forms and
     z-scores print as "none" (explained in the section's appendix)."""
     a_show = shown_a(summary) if a_show is None else a_show
     s = summary[summary["a"] == a_show]
@@ -86,8 +86,10 @@ def lqg_tables(
         columns={"x": "in", "n_points": "points", "low": "CI low", "high": "CI high"}
     ).assign(a=[param_text(a) for a in scaling["a"]])  # configuration values as written
     return {
-        "dec_lqg_regret": markdown_table(cells, digits=3, missing="none", signed=("z",)),
-        "dec_lqg_scaling": markdown_table(scal, digits=3, signed=("slope", "CI low", "CI high")),
+        "decisions_lqg_regret": markdown_table(cells, digits=3, missing="none", signed=("z",)),
+        "decisions_lqg_scaling": markdown_table(
+            scal, digits=3, signed=("slope", "CI low", "CI high")
+        ),
     }
 
 
@@ -189,8 +191,8 @@ def _appendix(summary: pd.DataFrame, tables: Mapping[str, str]) -> str:
         "section_lqg_appendix.md",
         a_shown=param_text(shown_a(summary)),
         zero_regret=fmt(max_rel_regret(summary, ZERO_REGRET), 2),
-        regret_table=tables["dec_lqg_regret"],
-        scaling_table=tables["dec_lqg_scaling"],
+        regret_table=tables["decisions_lqg_regret"],
+        scaling_table=tables["decisions_lqg_scaling"],
     )
 
 

@@ -33,7 +33,7 @@ from rsmhp.studies.decisions.summarise_uav import (
 __all__ = ["FIGURES", "uav_decision_section", "uav_tables"]
 
 #: figure stems of the section (the figure rule writes them; see decisions.smk)
-FIGURES = ("dec_uav_regret", "dec_uav_map")
+FIGURES = ("decisions_uav_regret", "decisions_uav_map")
 
 
 def _render(template: str, **values: Any) -> str:
@@ -90,11 +90,11 @@ def _map_table(map_df: pd.DataFrame) -> str:
 
 
 def uav_tables(summary: pd.DataFrame, map_df: pd.DataFrame) -> dict[str, str]:
-    """Markdown tables ``dec_uav_regret`` and ``dec_uav_map``: regrets and rates in percent,
-    "unlimited" for a footprint radius that is null; an undefined Spearman correlation (the
+    """Markdown tables ``decisions_uav_regret`` and ``decisions_uav_map``: regrets and rates in
+    percent, "unlimited" for a footprint radius that is null; an undefined Spearman correlation (the
     method's cost constant over the plans at every state) or Wilcoxon p-value (every paired
     difference 0) prints as "undefined"."""
-    return {"dec_uav_regret": _regret_table(summary), "dec_uav_map": _map_table(map_df)}
+    return {"decisions_uav_regret": _regret_table(summary), "decisions_uav_map": _map_table(map_df)}
 
 
 @dataclass(frozen=True)
@@ -294,11 +294,11 @@ def _appendix(cfg: Mapping[str, Any], tables: Mapping[str, str]) -> str:
         eval_maxiter=str(int(ucfg["eval_maxiter"])),
         n_random=str(int(ucfg["n_random"])),
         early_step=str(EARLY_STEP),
-        regret_table=tables["dec_uav_regret"],
+        regret_table=tables["decisions_uav_regret"],
         map_runs=str(int(mcfg["runs"])),
         regret_runs=str(int(mcfg["regret_runs"])),
         regret_steps=", ".join(str(int(s)) for s in mcfg["regret_steps"]),
-        map_table=tables["dec_uav_map"],
+        map_table=tables["decisions_uav_map"],
     )
 
 

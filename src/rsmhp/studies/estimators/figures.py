@@ -427,12 +427,12 @@ def frontier_figure(s: pd.DataFrame) -> plt.Figure:
 
 # file stem -> figure function of (summary, problems)
 FIGURES = {
-    "est_rmse_vs_n": lambda s, p: rmse_figure(s),
-    "est_bias_vs_n": lambda s, p: bias_figure(s),
-    "est_tree_variance": tree_variance_figure,
-    "est_weighted_vs_uniform": lambda s, p: weighted_vs_uniform_figure(s),
-    "est_pruning_heatmap": lambda s, p: pruning_heatmap(s),
-    "est_frontier": lambda s, p: frontier_figure(s),
+    "estimators_rmse_vs_n": lambda s, p: rmse_figure(s),
+    "estimators_bias_vs_n": lambda s, p: bias_figure(s),
+    "estimators_tree_variance": tree_variance_figure,
+    "estimators_weighted_vs_uniform": lambda s, p: weighted_vs_uniform_figure(s),
+    "estimators_pruning_heatmap": lambda s, p: pruning_heatmap(s),
+    "estimators_frontier": lambda s, p: frontier_figure(s),
 }
 
 

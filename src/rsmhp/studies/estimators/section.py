@@ -57,12 +57,12 @@ __all__ = [
 
 #: the figures the section shows, in order (drawn by :mod:`rsmhp.studies.estimators.figures`)
 FIGURES = (
-    "est_rmse_vs_n",
-    "est_bias_vs_n",
-    "est_tree_variance",
-    "est_weighted_vs_uniform",
-    "est_pruning_heatmap",
-    "est_frontier",
+    "estimators_rmse_vs_n",
+    "estimators_bias_vs_n",
+    "estimators_tree_variance",
+    "estimators_weighted_vs_uniform",
+    "estimators_pruning_heatmap",
+    "estimators_frontier",
 )
 #: text of a table cell without a value, explained under each table that uses it
 ABSENT = "—"
@@ -189,12 +189,12 @@ def tables(df: pd.DataFrame, s: pd.DataFrame, cheb: pd.DataFrame) -> dict[str, s
         }
     )
     return {
-        "est_largest": _largest_table(s),
-        "est_tree_vs_independent": markdown_table(tvi, digits=3),
-        "est_pruning": markdown_table(pruning_pivot(s), digits=3, missing=ABSENT),
-        "est_weighted": _weighted_table(s),
-        "est_equal_cpu": gain_table(s),
-        "est_chebyshev": _chebyshev_table(cheb),
+        "estimators_largest": _largest_table(s),
+        "estimators_tree_vs_independent": markdown_table(tvi, digits=3),
+        "estimators_pruning": markdown_table(pruning_pivot(s), digits=3, missing=ABSENT),
+        "estimators_weighted": _weighted_table(s),
+        "estimators_equal_cpu": gain_table(s),
+        "estimators_chebyshev": _chebyshev_table(cheb),
     }
 
 

@@ -1,9 +1,9 @@
 r"""Equal-compute study, claims FR-1-<model>, FR-2-<model>, FR-3-<model>: each a key number
 from :mod:`rsmhp.studies.frontier.summarise` and a verdict rule (:mod:`rsmhp.report.verdicts`)
 evaluated on facts. The compared members are the config's budget members
-(``decisions.frontier.budget.members``: one per family, the largest that fit the planning
+(``frontier.budget.members``: one per family, the largest that fit the planning
 budget per step in the study's first run); the rules' margins are
-``decisions.frontier.claims``. All key numbers are statistical (closed loop, optimiser); all
+``frontier.claims``. All key numbers are statistical (closed loop, optimiser); all
 claims are beyond the paper (part "beyond"), one per model variant of the study.
 
 * **FR-1** (:func:`fr1_rule`): d = open-loop relative regret of RQMC − that of Monte Carlo
@@ -302,10 +302,10 @@ def frontier_claims(
 ) -> list[Claim]:
     """FR-1..3 per model of ``summary`` (module doc), in the config's model order. ``runs``
     and ``regret``: the study's tables of every model; ``summary``:
-    :func:`rsmhp.studies.frontier.summarise.summarize_frontier`; ``cfg``: ``decisions.frontier``."""
+    :func:`rsmhp.studies.frontier.summarise.summarize_frontier`; ``cfg``: ``frontier``."""
     for key in ("budget", "claims", "bootstrap"):
         if key not in cfg:
-            raise ValueError(f"decisions.frontier lacks {key!r} (the config schema fills it)")
+            raise ValueError(f"frontier lacks {key!r} (the config schema fills it)")
     members = list(cfg["budget"]["members"])
     if summary.empty or not members:
         return []

@@ -5,10 +5,10 @@ states (percentage points); bottom row: closed-loop mean location error minus NB
 runs (m). x: planning milliseconds per step (median over runs, log scale). Each family is one
 line through its members in order of compute, in the palette's family colour, with the 95%
 bootstrap CI of every point as a vertical bar; NBO is the reference line at 0; the planning
-budget of the equal-compute claims (``decisions.frontier.budget.ms_per_step``), when given,
+budget of the equal-compute claims (``frontier.budget.ms_per_step``), when given,
 is a dotted vertical line.
 
-``dec_confirm`` (:func:`confirm_figure`), the confirmatory run of the protocol: columns are
+``frontier_confirm`` (:func:`confirm_figure`), the confirmatory run of the protocol: columns are
 model variants; each family's tuned members along the budget ladder as one line; rows: closed-
 loop mean location error minus NBO's (m, 95% t CIs over runs) against the planning
 milliseconds per step the budget counts (the ladder's ``cost_ms``,
@@ -32,9 +32,9 @@ from rsmhp.report.palette import METHOD_COLOURS, method_colour
 __all__ = ["CONFIRM_FIGURES", "FIGURES", "confirm_figure", "frontier_figure"]
 
 #: the confirmatory run's figure (:func:`confirm_figure`)
-CONFIRM_FIGURES = ["dec_confirm"]
+CONFIRM_FIGURES = ["frontier_confirm"]
 
-FIGURES = ["dec_frontier"]
+FIGURES = ["frontier_exploratory"]
 
 _ROWS = (
     ("regret_diff_pp", "open-loop regret − NBO's (pp)"),

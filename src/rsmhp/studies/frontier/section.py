@@ -37,7 +37,7 @@ __all__ = [
 ]
 
 #: table stems of the section (the summary rule writes them; see frontier.smk)
-TABLES = ("dec_frontier", "dec_frontier_budget")
+TABLES = ("frontier_exploratory", "frontier_budget")
 
 
 def _frontier_table(summary: pd.DataFrame) -> str:
@@ -89,17 +89,15 @@ def _budget_table(check: pd.DataFrame, summary: pd.DataFrame) -> str:
 
 
 def frontier_tables(summary: pd.DataFrame, cfg: Mapping[str, Any]) -> dict[str, str]:
-    """Markdown tables ``dec_frontier`` (every model and method: planning ms per step,
+    """Markdown tables ``frontier_exploratory`` (every model and method: planning ms per step,
     closed-loop error and its paired difference with NBO, track loss, open-loop relative
-    regret and its paired difference) and ``dec_frontier_budget`` (each budget member against
-    the budget on this run's times); ``cfg``: ``decisions.frontier``."""
+    regret and its paired difference) and ``frontier_budget`` (each budget member against
+    the budget on this run's times); ``cfg``: ``frontier``."""
     budget = cfg["budget"]
     check = budget_check(summary, list(budget["members"]), float(budget["ms_per_step"]))
     return {
-        "dec_frontier": _frontier_table(summary),
-        "dec_frontier_budget": (
-            _budget_table(check, summary) if len(check) else "(no budget members)"
-        ),
+        "frontier_exploratory": _frontier_table(summary),
+        "frontier_budget": (_budget_table(check, summary) if len(check) else "(no budget members)"),
     }
 
 
@@ -117,7 +115,7 @@ def _family_labels() -> dict[str, str]:
 class FrontierInputs:
     """What the exploratory section is built from: the closed-loop ``runs``, the open-loop
     ``regret``, their ``summary`` (:func:`rsmhp.studies.frontier.summarise.summarize_frontier`),
-    the Markdown ``tables`` (:func:`frontier_tables`), ``cfg`` = ``decisions.frontier``, the
+    the Markdown ``tables`` (:func:`frontier_tables`), ``cfg`` = ``frontier``, the
     root ``seed`` and ``horizon`` = the planners' H (``uav.planner.horizon``)."""
 
     runs: pd.DataFrame
@@ -248,9 +246,9 @@ def _appendix(inputs: FrontierInputs) -> str:
         "appendix.md",
         track_loss_error=param_text(cfg["track_loss_error"]),
         bootstrap=int(cfg["bootstrap"]),
-        frontier_table=inputs.tables["dec_frontier"],
+        frontier_table=inputs.tables["frontier_exploratory"],
         budget_ms=param_text(float(cfg["budget"]["ms_per_step"])),
-        budget_table=inputs.tables["dec_frontier_budget"],
+        budget_table=inputs.tables["frontier_budget"],
         sigma_points=8 * (horizon + 1),
         horizon=horizon,
         dimension=4 * (horizon + 1),
@@ -264,12 +262,12 @@ def _appendix(inputs: FrontierInputs) -> str:
 
 def frontier_section(inputs: FrontierInputs) -> Section:
     """The exploratory equal-compute design's report section (order 33, only with
-    ``decisions.frontier.exploratory``). Its comparisons FR-1..3 were chosen on the data
+    ``frontier.exploratory``). Its comparisons FR-1..3 were chosen on the data
     that judge them: they are printed as exploratory findings, never as claims of the
     ledger (the ledger's FR claims come from the confirmatory run)."""
     claims = frontier_claims(inputs.runs, inputs.regret, inputs.summary, inputs.cfg, inputs.seed)
     return Section(
-        key="decisions_frontier_exploratory",
+        key="frontier_exploratory",
         title="Planners at equal compute: the exploratory design",
         order=33,
         body=_body(inputs, claims),
@@ -282,7 +280,7 @@ def frontier_section(inputs: FrontierInputs) -> Section:
 # ------------------------------------------------------------------------ the protocol
 
 #: table stems of the confirmatory section (rule frontier_confirm_summary)
-CONFIRM_TABLES = ("dec_confirm", "dec_confirm_ladder", "dec_confirm_tuning")
+CONFIRM_TABLES = ("frontier_confirm", "frontier_confirm_ladder", "frontier_confirm_tuning")
 
 
 def _config_table(summary: pd.DataFrame) -> str:
@@ -363,14 +361,14 @@ def _tuning_table(tuned: Mapping[str, Any]) -> str:
 def confirm_tables(
     summary: pd.DataFrame, lad: pd.DataFrame, tuned: Mapping[str, Any]
 ) -> dict[str, str]:
-    """Markdown tables of the confirmatory section: ``dec_confirm`` (every configuration:
+    """Markdown tables of the confirmatory section: ``frontier_confirm`` (every configuration:
     both compute units, optimiser and depth statistics, error and its difference with NBO),
-    ``dec_confirm_ladder`` (per model, budget and family: the tuned member against Monte
-    Carlo's) and ``dec_confirm_tuning`` (what the tuning chose, with its tuning numbers)."""
+    ``frontier_confirm_ladder`` (per model, budget and family: the tuned member against Monte
+    Carlo's) and ``frontier_confirm_tuning`` (what the tuning chose, with its tuning numbers)."""
     return {
-        "dec_confirm": _config_table(summary),
-        "dec_confirm_ladder": _ladder_table(lad),
-        "dec_confirm_tuning": _tuning_table(tuned),
+        "frontier_confirm": _config_table(summary),
+        "frontier_confirm_ladder": _ladder_table(lad),
+        "frontier_confirm_tuning": _tuning_table(tuned),
     }
 
 
@@ -624,20 +622,20 @@ def confirm_section(inputs: ConfirmInputs) -> Section:
     )
     appendix = _render(
         "confirm_appendix.md",
-        config_table=inputs.tables["dec_confirm"],
-        ladder_table=inputs.tables["dec_confirm_ladder"],
-        tuning_table=inputs.tables["dec_confirm_tuning"],
+        config_table=inputs.tables["frontier_confirm"],
+        ladder_table=inputs.tables["frontier_confirm_ladder"],
+        tuning_table=inputs.tables["frontier_confirm_tuning"],
         best=_best_per_budget(inputs.lad),
         tree=_tree_depths(inputs.summary),
         exploratory_table=_exploratory_table(inputs.exploratory),
         superseded=superseded,
     )
     return Section(
-        key="decisions_frontier",
+        key="frontier",
         title="Planners at equal compute (confirmatory)",
         order=32,
         body=body,
         claims=list(inputs.claims),
-        figures=["dec_confirm"],
+        figures=["frontier_confirm"],
         appendix=appendix,
     )

@@ -1,4 +1,4 @@
-r"""Equal-compute study of the UAV planners (the ``decisions.frontier`` config section): every
+r"""Equal-compute study of the UAV planners (the ``frontier`` config section): every
 planner family at several sizes, on named model variants of the decision study, with the
 compute each one spends measured in the same job.
 
@@ -95,17 +95,17 @@ FRONTIER_RUN_COLUMNS = [
 DEPTH_COLUMNS = ("plan_depth", "max_depth", "root_actions", "frac_depth1")
 
 #: one row per (repeat, belief state, method) of the interleaved timing (rule
-#: ``decisions_frontier_timing``): the wall time of one plan call (ms) and its work
+#: ``frontier_explore_timing``): the wall time of one plan call (ms) and its work
 TIMING_COLUMNS = ["model", "method", "repeat", "run", "step", "slot", "ms", "work"]
 
 
 def frontier_contracts(cfg: Mapping[str, Any], model: str) -> tuple[Contract, Contract]:
-    """What the rule ``decisions_frontier`` writes for ``model``: one closed-loop row per
+    """What the rule ``frontier_explore`` writes for ``model``: one closed-loop row per
     (method, run) and one open-loop row per (run, step, method)."""
-    names = list(methods.from_config(cfg["methods"], "decisions.frontier.methods"))
+    names = list(methods.from_config(cfg["methods"], "frontier.methods"))
     keys = [(m, r) for m in names for r in range(int(cfg["runs"]))]
     runs = Contract(
-        rule="decisions_frontier",
+        rule="frontier_explore",
         columns=FRONTIER_RUN_COLUMNS,
         text=("model", "method", "family"),
         boolean=("lost",),
@@ -117,7 +117,7 @@ def frontier_contracts(cfg: Mapping[str, Any], model: str) -> tuple[Contract, Co
         values={"model": model},
     )
     regret = _regret_contract(
-        "decisions_frontier", [model], cfg["regret_runs"], cfg["regret_steps"], cfg["methods"]
+        "frontier_explore", [model], cfg["regret_runs"], cfg["regret_steps"], cfg["methods"]
     )
     return runs, regret
 
@@ -133,10 +133,10 @@ def run_frontier_model(
     """The study for one model variant (see the module docstring): ``(closed-loop rows,
     FRONTIER_RUN_COLUMNS; open-loop rows, REGRET_COLUMNS with ``model`` = the variant's
     name)``. ``uav`` is the (validated) ``uav`` section, ``models`` ``decisions.uav.models``,
-    ``cfg`` the ``decisions.frontier`` section, ``scoring`` the ``decisions.uav`` section.
+    ``cfg`` the ``frontier`` section, ``scoring`` the ``decisions.uav`` section.
     Runs on one thread: the planning times are the study's measure of compute."""
     uav_cfg = merge_variant(uav, variant(models, model))
-    planners = methods.from_config(cfg["methods"], "decisions.frontier.methods")
+    planners = methods.from_config(cfg["methods"], "frontier.methods")
     runs = range(int(cfg["runs"]))
     jobs = [(uav_cfg, planners[m], seed, r) for m in planners for r in runs]
     setup = UAVSetup.from_config(uav_cfg)
@@ -186,20 +186,20 @@ def recording_setup(
     model: str,
 ) -> tuple[UAVSetup, list[methods.Method]]:
     """The setup of the frontier's model variant ``model`` and the methods its recording
-    shows: NBO, then the budget member of every family (``decisions.frontier.budget.members``,
-    in table order). ``cfg`` is ``decisions.frontier``. A model the frontier does not run, or
+    shows: NBO, then the budget member of every family (``frontier.budget.members``,
+    in table order). ``cfg`` is ``frontier``. A model the frontier does not run, or
     a member it does not run, is refused naming the field."""
     if model not in list(cfg["models"]):
         raise ValueError(
-            f"decisions.recording.model: {model!r} is not a model of decisions.frontier.models "
+            f"frontier.recording.model: {model!r} is not a model of frontier.models "
             f"(allowed: {', '.join(map(str, cfg['models'])) or 'none configured'})"
         )
-    run = methods.from_config(cfg["methods"], "decisions.frontier.methods")
+    run = methods.from_config(cfg["methods"], "frontier.methods")
     members = list(cfg["budget"]["members"])
     unknown = [m for m in members if m not in run]
     if unknown:
         raise ValueError(
-            f"decisions.frontier.budget.members: {unknown} not run by decisions.frontier.methods "
+            f"frontier.budget.members: {unknown} not run by frontier.methods "
             f"(allowed: {', '.join(run)})"
         )
     base = methods.baseline()()
@@ -209,9 +209,9 @@ def recording_setup(
 
 
 def timing_contract(cfg: Mapping[str, Any], model: str) -> Contract:
-    """What the rule ``decisions_frontier_timing`` writes for ``model``: one row per (repeat,
-    belief state, method) of ``cfg["timing"]`` (``decisions.frontier``)."""
-    names = list(methods.from_config(cfg["methods"], "decisions.frontier.methods"))
+    """What the rule ``frontier_explore_timing`` writes for ``model``: one row per (repeat,
+    belief state, method) of ``cfg["timing"]`` (``frontier``)."""
+    names = list(methods.from_config(cfg["methods"], "frontier.methods"))
     t = cfg["timing"]
     keys = [
         (m, rep, run, step)
@@ -221,7 +221,7 @@ def timing_contract(cfg: Mapping[str, Any], model: str) -> Contract:
         for m in names
     ]
     return Contract(
-        rule="decisions_frontier_timing",
+        rule="frontier_explore_timing",
         columns=TIMING_COLUMNS,
         text=("model", "method"),
         integer=("repeat", "run", "step", "slot", "work"),
@@ -241,7 +241,7 @@ def time_planners(
     """Interleaved timing (:func:`time_configurations`) of every method of ``cfg["methods"]``
     at its default optimiser budget, at ``cfg["timing"]``'s belief states
     (:data:`TIMING_COLUMNS`: ``method`` names the method)."""
-    planners = methods.from_config(cfg["methods"], "decisions.frontier.methods")
+    planners = methods.from_config(cfg["methods"], "frontier.methods")
     configs = [Configuration(m) for m in planners]
     t = time_configurations(uav, models, model, configs, cfg["timing"], seed)
     return t.rename(columns={"config": "method"})[TIMING_COLUMNS]

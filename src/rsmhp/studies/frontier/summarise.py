@@ -1,9 +1,9 @@
 r"""Equal-compute study: statistics of the planner frontier (tables -> numbers, no prose).
 
-Per (model, method), from the rule ``decisions_frontier``'s tables:
+Per (model, method), from the rule ``frontier_explore``'s tables:
 
 * compute, in two units: wall clock, ``plan_ms``, the median planning milliseconds per step
-  of the interleaved timing (rule ``decisions_frontier_timing``: every method at the same
+  of the interleaved timing (rule ``frontier_explore_timing``: every method at the same
   belief states, round robin, several passes), with ``plan_lo_ms`` / ``plan_hi_ms`` the
   smallest and largest per-pass median (the spread from one pass to the next) and
   ``loop_ms`` the closed loop's own planning time per step (the mean over runs of a run's
@@ -301,7 +301,7 @@ def budget_check(summary: pd.DataFrame, members: Sequence[str], budget_ms: float
     return pd.DataFrame(rows, columns=BUDGET_COLUMNS)
 
 
-#: rules of :func:`select_run` (the config's decisions.recording.select)
+#: rules of :func:`select_run` (the config's frontier.recording.select)
 RUN_SELECTIONS = ("nearest_mean", "nearest_median", "largest_gain", "largest_loss")
 
 
@@ -311,7 +311,7 @@ def select_run(
     a: str,
     b: str,
     rule: str,
-    path: str = "decisions.recording.select",
+    path: str = "frontier.recording.select",
 ) -> tuple[int, float]:
     """The run of ``model`` a recording shows and its d_r = mean_error(``a``) − that of
     ``b`` (m): ``rule`` "nearest_mean" / "nearest_median": d_r nearest the mean / median of d

@@ -1,16 +1,16 @@
 r"""The UAV horizon study: cost-approximation error, planning time and regret against H.
 
-``hz_uav_error``: columns are model variants; top row the relative RMSE of each method's cost
+``horizon_uav_error``: columns are model variants; top row the relative RMSE of each method's cost
 estimate (%, log scale, noise-corrected; 95% cluster-t CIs over runs; an RMSE the
 reference's noise hides, corrected to 0, is drawn at :data:`RMSE_FLOOR_PCT`), bottom row its
-relative bias (%). ``hz_uav_time``: top row the median planning milliseconds per step
+relative bias (%). ``horizon_uav_time``: top row the median planning milliseconds per step
 (log scale), bottom row the open-loop regret against the best of the methods' own plans (% of
 the best cost; it mixes approximation and optimisation error, which the optimiser-split study
-separates). x: the horizon H (log scale). ``hz_uav_closed``: the closed-loop mean location
+separates). x: the horizon H (log scale). ``horizon_uav_closed``: the closed-loop mean location
 error minus NBO's on the same runs (m, 95% Student-t CIs over runs). One line per method in
 its palette colour.
 
-``hz_lqg`` (oven LQG, exact oracle; one row per simulated a): left, the relative RMSE (%,
+``horizon_lqg`` (oven LQG, exact oracle; one row per simulated a): left, the relative RMSE (%,
 log scale) of each cost estimator with n trajectories (the largest n of the study: Monte
 Carlo, RQMC, the pruned trees keeping M = n, one shade per N) and NBO, 95% bootstrap CIs over
 replicates; right, the mean regret of uniform Monte Carlo per P with its 95% t-CI, the closed
@@ -36,7 +36,7 @@ __all__ = [
     "horizon_time_figure",
 ]
 
-FIGURES = ["hz_uav_error", "hz_uav_time", "hz_uav_closed", "hz_lqg"]
+FIGURES = ["horizon_uav_error", "horizon_uav_time", "horizon_uav_closed", "horizon_lqg"]
 
 #: relative RMSEs below this (%) are drawn at it (the log axis has no 0)
 RMSE_FLOOR_PCT = 1e-3
@@ -98,8 +98,8 @@ def _grid(summary: pd.DataFrame, rows, title: str) -> plt.Figure:
 
 
 def horizon_error_figure(approx_summary: pd.DataFrame) -> plt.Figure:
-    """``hz_uav_error`` from :func:`rsmhp.studies.horizon.summarise_uav.summarize_approx` (module
-    doc)."""
+    """``horizon_uav_error`` from :func:`rsmhp.studies.horizon.summarise_uav.summarize_approx`
+    (module doc)."""
     s = approx_summary.copy()
     for c in ("rel_rmse", "rel_rmse_low", "rel_rmse_high", "rel_bias", "rel_bias_low",
               "rel_bias_high"):  # fmt: skip
@@ -112,7 +112,8 @@ def horizon_error_figure(approx_summary: pd.DataFrame) -> plt.Figure:
 
 
 def horizon_time_figure(regret_summary: pd.DataFrame) -> plt.Figure:
-    """``hz_uav_time`` from :func:`rsmhp.studies.horizon.summarise_uav.summarize_horizon_regret`."""
+    """``horizon_uav_time`` from
+    :func:`rsmhp.studies.horizon.summarise_uav.summarize_horizon_regret`."""
     rows = [
         ("plan_ms", "planning ms per step (median)", True, None),
         ("regret_methods_pct", "regret vs the methods' best plan (%)", False, None),
@@ -121,7 +122,7 @@ def horizon_time_figure(regret_summary: pd.DataFrame) -> plt.Figure:
 
 
 def horizon_closed_figure(closed_summary: pd.DataFrame) -> plt.Figure:
-    """``hz_uav_closed`` from :func:`rsmhp.studies.horizon.summarise_uav.summarize_closed`."""
+    """``horizon_uav_closed`` from :func:`rsmhp.studies.horizon.summarise_uav.summarize_closed`."""
     rows = [("error_diff", "closed-loop mean error − NBO's (m)", False, None)]
     return _grid(closed_summary, rows, "Closed loop against NBO, by horizon")
 
@@ -130,7 +131,7 @@ _LQG_SCHEMES = {"nbo": "NBO", "mc": "Monte Carlo", "sobol": "RQMC (Sobol')"}
 
 
 def horizon_lqg_figure(est_summary: pd.DataFrame, regret_summary: pd.DataFrame) -> plt.Figure:
-    """``hz_lqg`` from :func:`rsmhp.studies.horizon.summarise_lqg.summarize_lqg_estimators` and
+    """``horizon_lqg`` from :func:`rsmhp.studies.horizon.summarise_lqg.summarize_lqg_estimators` and
     :func:`rsmhp.studies.horizon.summarise_lqg.summarize_lqg_horizon_regret` (module doc)."""
     theme()
     a_vals = sorted(float(a) for a in est_summary["a"].unique())

@@ -1,4 +1,4 @@
-r"""The optimiser split of the UAV open-loop regret against the horizon (``hz_optimiser``).
+r"""The optimiser split of the UAV open-loop regret against the horizon (``horizon_optimiser``).
 
 One panel per model variant; x: the horizon H (log scale); y: regret in percent of the best
 plan found (symmetric log scale, linear within :data:`LINTHRESH_PCT` of 0, so that a zero
@@ -38,7 +38,7 @@ __all__ = [
     "optimiser_figure",
 ]
 
-FIGURES = ["hz_optimiser"]
+FIGURES = ["horizon_optimiser"]
 
 #: the symlog axis is linear within ± this many percent
 LINTHRESH_PCT = 0.01
@@ -79,7 +79,7 @@ def _yerr(g: pd.DataFrame, prefix: str) -> tuple[np.ndarray, np.ndarray]:
 
 
 def optimiser_figure(summary: pd.DataFrame) -> plt.Figure:
-    """``hz_optimiser`` from the summary of :func:`rsmhp.studies.horizon.summarise_optimiser.
+    """``horizon_optimiser`` from the summary of :func:`rsmhp.studies.horizon.summarise_optimiser.
     summarize_split` (module doc)."""
     theme()
     models = list(dict.fromkeys(summary["model"]))

@@ -27,12 +27,12 @@ from rsmhp.studies.horizon.section_optimiser import horizon_note
 __all__ = ["FIGURES", "TABLES", "HorizonInputs", "horizon_section", "horizon_tables"]
 
 TABLES = (
-    "hz_uav_approx",
-    "hz_uav_regret",
-    "hz_uav_closed",
-    "hz_lqg",
-    "hz_lqg_estimators",
-    "hz_lqg_regret",
+    "horizon_uav_approx",
+    "horizon_uav_regret",
+    "horizon_uav_closed",
+    "horizon_lqg",
+    "horizon_lqg_estimators",
+    "horizon_lqg_regret",
 )
 _PACKAGE = "rsmhp.studies.horizon"
 
@@ -45,15 +45,15 @@ def horizon_tables(
     lqg_estimators: pd.DataFrame,
     lqg_regret: pd.DataFrame,
 ) -> dict[str, str]:
-    """Markdown tables ``hz_uav_approx`` (per model, H and method: relative bias and RMSE of
+    """Markdown tables ``horizon_uav_approx`` (per model, H and method: relative bias and RMSE of
     the cost estimate in percent with cluster-t CIs over runs, the reference's relative SE,
-    rank correlation), ``hz_uav_regret`` (relative regret against the best plan found and
-    against the best of the methods' own plans, planning ms), ``hz_uav_closed`` (closed-loop
+    rank correlation), ``horizon_uav_regret`` (relative regret against the best plan found and
+    against the best of the methods' own plans, planning ms), ``horizon_uav_closed`` (closed-loop
     error and its paired difference with NBO with a t CI over runs, the runs a confirmatory
-    comparison needs for 80% power at the observed difference), ``hz_lqg``
-    (:func:`rsmhp.studies.horizon.summarise_uav.lqg_horizon_table`), ``hz_lqg_estimators`` (oven
-    LQG: relative bias and RMSE of each estimator against the exact J by a and H,
-    :func:`rsmhp.studies.horizon.summarise_lqg.summarize_lqg_estimators`) and ``hz_lqg_regret``
+    comparison needs for 80% power at the observed difference), ``horizon_lqg``
+    (:func:`rsmhp.studies.horizon.summarise_uav.lqg_horizon_table`), ``horizon_lqg_estimators``
+    (oven LQG: relative bias and RMSE of each estimator against the exact J by a and H,
+    :func:`rsmhp.studies.horizon.summarise_lqg.summarize_lqg_estimators`) and ``horizon_lqg_regret``
     (mean regret with CI, closed form, its limit and z,
     :func:`rsmhp.studies.horizon.summarise_lqg.summarize_lqg_horizon_regret`)."""
     a = approx_summary
@@ -146,12 +146,12 @@ def horizon_tables(
         }
     )
     return {
-        "hz_uav_approx": markdown_table(t1, digits=3, missing="undefined", signed=("bias %",)),
-        "hz_uav_regret": markdown_table(t2, digits=3),
-        "hz_uav_closed": markdown_table(t4, digits=3, missing="–", signed=("− NBO (m)",)),
-        "hz_lqg": markdown_table(t3, digits=4),
-        "hz_lqg_estimators": markdown_table(t5, digits=3, missing="–", signed=("bias %",)),
-        "hz_lqg_regret": markdown_table(t6, digits=3, missing="–"),
+        "horizon_uav_approx": markdown_table(t1, digits=3, missing="undefined", signed=("bias %",)),
+        "horizon_uav_regret": markdown_table(t2, digits=3),
+        "horizon_uav_closed": markdown_table(t4, digits=3, missing="–", signed=("− NBO (m)",)),
+        "horizon_lqg": markdown_table(t3, digits=4),
+        "horizon_lqg_estimators": markdown_table(t5, digits=3, missing="–", signed=("bias %",)),
+        "horizon_lqg_regret": markdown_table(t6, digits=3, missing="–"),
     }
 
 
@@ -198,7 +198,7 @@ class HorizonInputs:
 
 
 def _lqg_text(q: pd.DataFrame, a_model: float, eps: float) -> str:
-    """The oven LQG at long horizons for the model's a (closed forms, table hz_lqg;
+    """The oven LQG at long horizons for the model's a (closed forms, table horizon_lqg;
     ``lqg_limits.md``)."""
     row = q.iloc[int(np.argmin(np.abs(q["a"].to_numpy(float) - a_model)))]
     shares = [c for c in q.columns if c.startswith("nbo_share_H")]
@@ -222,8 +222,8 @@ def _lqg_text(q: pd.DataFrame, a_model: float, eps: float) -> str:
 
 
 def _lqg_sim_values(est: pd.DataFrame, reg: pd.DataFrame, a_model: float) -> dict | None:
-    """The simulated oven LQG at long horizons (tables hz_lqg_estimators, hz_lqg_regret), at
-    the model's a (or the nearest simulated a); None without simulation rows. ``trees``: the
+    """The simulated oven LQG at long horizons (tables horizon_lqg_estimators, horizon_lqg_regret),
+    at the model's a (or the nearest simulated a); None without simulation rows. ``trees``: the
     pruned trees per N; ``decisions``: uniform Monte Carlo's regret (None without it);
     ``weighted``: the likeliness-weighted cell farthest from its first-order form (None
     unless some |z| > 3)."""
@@ -302,7 +302,7 @@ def _lqg_sim_values(est: pd.DataFrame, reg: pd.DataFrame, a_model: float) -> dic
 
 def _runs_values(closed_summary: pd.DataFrame | None) -> list[dict[str, Any]] | None:
     """Per model, how many runs the closed-loop comparisons used and would need (column
-    'runs for 80% power' of hz_uav_closed): ``need`` the finite counts of the unresolved
+    'runs for 80% power' of horizon_uav_closed): ``need`` the finite counts of the unresolved
     comparisons (None if none is finite), ``beyond`` how many need more than 10⁶ runs; None
     without closed-loop counts."""
     if closed_summary is None:

@@ -1,7 +1,7 @@
 """Optimiser split of the UAV open-loop regret, report section (order 34, right after the
 long-horizon section, order 33): the definitions, the measured split by model and horizon,
 the optimiser's iterations and convergence, and which budget removes the optimisation part;
-the table ``hz_optimiser`` and the figure ``hz_optimiser``. A measurement: no claims.
+the table ``horizon_optimiser`` and the figure ``horizon_optimiser``. A measurement: no claims.
 
 Every number of the text is read from the summary (:func:`optimiser_summary`) or the config
 (``horizon.optimiser``, ``uav.planner``); none is typed. :func:`horizon_note` is the sentence
@@ -52,7 +52,7 @@ KEY = "horizon_optimiser"
 TITLE = "Optimiser error apart from approximation error"
 #: right after the long-horizon section (33)
 ORDER = 34
-TABLES = ("hz_optimiser",)
+TABLES = ("horizon_optimiser",)
 _PACKAGE = "rsmhp.studies.horizon"
 
 _GROUP = ["model", "H", "method", "family", "maxiter", "restarts"]
@@ -79,7 +79,7 @@ def optimiser_summary(table: pd.DataFrame) -> pd.DataFrame:
 
 
 def optimiser_tables(summary: pd.DataFrame) -> dict[str, str]:
-    """Markdown table ``hz_optimiser``: per model, H, method and budget the states, the mean
+    """Markdown table ``horizon_optimiser``: per model, H, method and budget the states, the mean
     total, approximation and optimisation regret (%) with 95% cluster-t CIs over runs, mean
     iterations, shares of converged plans, of plans at 0 iterations and of states whose
     near-global minimiser came from the polish."""
@@ -106,7 +106,7 @@ def optimiser_tables(summary: pd.DataFrame) -> dict[str, str]:
             "x* from polish %": 100 * s["polish_star_share"],
         }
     )
-    return {"hz_optimiser": markdown_table(t, digits=3, signed=("O %",))}
+    return {"horizon_optimiser": markdown_table(t, digits=3, signed=("O %",))}
 
 
 def _weighted(g: pd.DataFrame, col: str) -> float:
@@ -287,7 +287,7 @@ def optimiser_section(
     ``horizon.optimiser``, ``planner`` ``uav.planner`` (maxiter, maxfun, restarts: whether
     the first budget is the closed-loop studies'). The text is ``section_optimiser.md``
     (main text: the split and what removes it) and ``section_optimiser_appendix.md``
-    (definitions, setting, the per-budget table and ``hz_optimiser``)."""
+    (definitions, setting, the per-budget table and ``horizon_optimiser``)."""
     if summary.empty:
         raise ValueError("optimiser summary is empty: no (model, H) was run")
     order = budget_order(summary)
@@ -306,7 +306,7 @@ def optimiser_section(
         "section_optimiser_appendix.md",
         **_appendix_values(summary, cfg, planner),
         per_budget=per_budget,
-        table=tables["hz_optimiser"],
+        table=tables["horizon_optimiser"],
     )
     return Section(
         key=KEY,

@@ -14,7 +14,7 @@ from rsmhp.report.palette import method_label
 __all__ = ["FIGURES", "improvement_figure"]
 
 #: figure stems (results/figures/<stem>.png)
-FIGURES = ["scn_improvement"]
+FIGURES = ["scenarios_improvement"]
 
 _MARKERS = ("o", "s", "D", "^")
 

@@ -21,12 +21,12 @@ __all__ = ["ORDER", "TABLES", "scenarios_section", "scenarios_tables"]
 #: after the long-horizon and optimiser sections
 ORDER = 35
 #: table stems (results/tables/<stem>.md)
-TABLES = ("scn_improvement", "scn_per_scenario")
+TABLES = ("scenarios_improvement", "scenarios_per_scenario")
 
 
 def scenarios_tables(summary: pd.DataFrame, per: pd.DataFrame) -> dict[str, str]:
-    """``scn_improvement`` (per group and method: scenarios, probability of improvement over
-    NBO with its 95% interval, share of scenarios above 1/2) and ``scn_per_scenario`` (per
+    """``scenarios_improvement`` (per group and method: scenarios, probability of improvement over
+    NBO with its 95% interval, share of scenarios above 1/2) and ``scenarios_per_scenario`` (per
     scenario and method: paired runs, probability, mean difference)."""
     t = pd.DataFrame(
         {
@@ -48,8 +48,8 @@ def scenarios_tables(summary: pd.DataFrame, per: pd.DataFrame) -> dict[str, str]
         }
     )
     return {
-        "scn_improvement": markdown_table(t, digits=3),
-        "scn_per_scenario": markdown_table(p, digits=3, signed=("mean error − NBO's (m)",)),
+        "scenarios_improvement": markdown_table(t, digits=3),
+        "scenarios_per_scenario": markdown_table(p, digits=3, signed=("mean error − NBO's (m)",)),
     }
 
 
@@ -113,10 +113,10 @@ def scenarios_section(summary: pd.DataFrame, tables: dict[str, str]) -> Section:
             empty=summary.empty,
             groups=[_group_text(summary, g) for g in groups],
         ),
-        figures=["scn_improvement"],
+        figures=["scenarios_improvement"],
         appendix=_render(
             "appendix.md",
-            improvement_table=tables["scn_improvement"],
-            per_scenario_table=tables["scn_per_scenario"],
+            improvement_table=tables["scenarios_improvement"],
+            per_scenario_table=tables["scenarios_per_scenario"],
         ),
     )

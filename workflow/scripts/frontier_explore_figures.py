@@ -1,4 +1,4 @@
-"""Rule decisions_frontier_figures: the planner frontier (PNG + PDF)."""
+"""Rule frontier_explore_figures: the planner frontier (PNG + PDF)."""
 
 from pathlib import Path
 
@@ -12,4 +12,4 @@ with rule_logging(snakemake):
     outdir = Path(snakemake.output[0]).parent
     summary = read_table(snakemake.input.summary, FRONTIER_SUMMARY_COLUMNS)
     budget = float(snakemake.params.budget["ms_per_step"])
-    save_figure(frontier_figure(summary, budget), outdir / "dec_frontier")
+    save_figure(frontier_figure(summary, budget), outdir / "frontier_exploratory")

@@ -1,4 +1,4 @@
-"""Rule decisions_frontier_timing: interleaved wall-clock timing of every method's plan call
+"""Rule frontier_explore_timing: interleaved wall-clock timing of every method's plan call
 on one model variant of the equal-compute study."""
 
 from rsmhp.pipeline.io import write_csv

@@ -1,4 +1,4 @@
-"""Rule decisions_frontier: the equal-compute study of one model variant (closed and open
+"""Rule frontier_explore: the equal-compute study of one model variant (closed and open
 loop, planning time per step)."""
 
 from rsmhp.pipeline.io import write_csv

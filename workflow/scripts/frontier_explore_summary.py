@@ -1,5 +1,5 @@
-"""Rule decisions_frontier_summary: per (model, method) compute, closed- and open-loop
-quality with bootstrap CIs (results/decisions/frontier_summary.csv), the tables, claims
+"""Rule frontier_explore_summary: per (model, method) compute, closed- and open-loop
+quality with bootstrap CIs (results/frontier/explore_summary.csv), the tables, claims
 FR-1..3 and the report section."""
 
 from pathlib import Path

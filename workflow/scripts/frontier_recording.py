@@ -1,5 +1,5 @@
-"""Rule decisions_frontier_recording: one closed-loop run of a frontier model variant, NBO and
-every family's budget member side by side, in the run chosen by decisions.recording.select
+"""Rule frontier_recording: one closed-loop run of a frontier model variant, NBO and
+every family's budget member side by side, in the run chosen by frontier.recording.select
 from the frontier's paired differences (Monte-Carlo budget member − NBO)."""
 
 from rsmhp.models.uav.methods import baseline
@@ -22,7 +22,7 @@ with rule_logging(snakemake) as log:
     run, d = select_run(runs, model, compare, base, rec["select"])
     log.info("%s: run %d (%s of %s − %s: d = %+.3f m)", model, run, rec["select"], compare, base, d)
     note = (
-        f"Run {run} of model '{model}', chosen by decisions.recording.select = "
+        f"Run {run} of model '{model}', chosen by frontier.recording.select = "
         f"{rec['select']} on d_r = mean location error of {compare} − {base} over the "
         f"frontier's runs (this run: d = {d:+.3f} m)."
     )
