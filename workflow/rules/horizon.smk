@@ -25,7 +25,7 @@ HZ_RECORDING = (
     else []
 )
 if HZ_MODELS:
-    REPORT_SECTIONS["horizon_uav"] = "results/report/horizon_uav.json"
+    REPORT_SECTIONS["horizon"] = "results/report/horizon.json"
     REPORT_FIGURES.extend(HORIZON_FIGURES)
 # Optimiser error apart from approximation error (horizon.optimiser): one job per model
 # variant and H (models: default horizon.uav.models), then the summary with its report
@@ -167,7 +167,7 @@ rule horizon_summary:
         lqg_estimators="results/horizon/lqg_estimators_summary.csv",
         lqg_regret="results/horizon/lqg_regret_summary.csv",
         tables=table_outputs(HORIZON_TABLES, "Long horizons"),
-        section="results/report/horizon_uav.json",
+        section="results/report/horizon.json",
     log:
         "results/logs/horizon_summary.log",
     benchmark:

@@ -465,7 +465,7 @@ def horizon_section(inputs: HorizonInputs) -> Section:
         eps=fmt(float(i.lqg_cfg["eps"]), 2),
     )
     return Section(
-        key="horizon_uav",
+        key="horizon",
         title="Long horizons: UAV cost approximation, decisions and time",
         order=33,
         body=body,
