@@ -262,7 +262,7 @@ def test_horizon_section_without_the_optional_inputs(inputs, calls):
     _check_text(s.body, s.appendix)
     assert s.appendix.startswith("\n\n\n\nCost approximation per model")
     assert "horizon_lqg.png" not in s.body and s.body.endswith("by horizon.*\n")
-    assert "runs at uav.planner's budget, the same for every method" in s.body
+    assert "runs at uav.planner's budget for every method" in s.body
     assert "is in section 'Optimiser error apart from approximation error'." in s.body
 
 
