@@ -35,7 +35,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
 	@# compile the numba planner kernels once per machine (on-disk cache; every job loads it)
-	$(BIN)/python -c 'from rsmhp.models.uav import fused; from rsmhp.experiments import decisions_lqg as d; print(f"compiled kernels ready in {fused.warm_up() + d.warm_up():.1f} s")'
+	$(BIN)/python -c 'from rsmhp.models.uav import fused; from rsmhp.models.lqg import regret as d; print(f"compiled kernels ready in {fused.warm_up() + d.warm_up():.1f} s")'
 	@touch $(STAMP)
 
 setup: $(STAMP)
