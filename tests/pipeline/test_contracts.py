@@ -436,14 +436,15 @@ def test_the_workflow_refuses_chunks_of_mixed_or_outdated_code(run_j2, tmp_path)
     shutil.copytree(run_j2, wd, symlinks=True)
     chunks = sorted((wd / "results/uav/chunks").glob("*/*.*"))
     assert len(chunks) >= 4
-    good = pd.read_csv(chunks[0])["code"].iloc[0]
-    assert good.startswith("uav_simulate:")
+    nbo = wd / "results/uav/chunks/nbo/0.csv"
+    # a simulation's stamp names its rule and the method families its digest counts
+    good = pd.read_csv(nbo)["code"].iloc[0]
+    assert good.startswith("uav_simulate+nbo:")
 
     def restamp(path: Path, digest: str) -> None:
         df = _read(path)
-        _save(df.assign(code=f"uav_simulate:{digest}"), path)
+        _save(df.assign(code=df["code"].str.rsplit(":", n=1).str[0] + f":{digest}"), path)
 
-    nbo = wd / "results/uav/chunks/nbo/0.csv"
     restamp(nbo, "000000000000")  # one chunk from older code
     before = {p: p.read_bytes() for p in chunks}
     res = snakemake(wd, "-j1", "uav_collect")
@@ -452,7 +453,8 @@ def test_the_workflow_refuses_chunks_of_mixed_or_outdated_code(run_j2, tmp_path)
     assert "Error in rule uav_collect" in out and "Traceback" not in out
     assert "failed: results/uav/chunks/nbo/0.csv by code 000000000000; " in out
     assert f"by code {good.split(':')[1]}: inputs made by different versions of the code" in out
-    assert "of rule uav_simulate" in out and "`snakemake -j2 --forcerun uav_simulate`" in out
+    assert "of rule uav_simulate (method families nbo)" in out
+    assert "`snakemake -j2 --forcerun uav_simulate`" in out
     assert {p: p.read_bytes() for p in chunks} == before  # nothing overwritten
     assert not (wd / "results/uav/runs.csv").exists()  # and nothing aggregated
     for path in chunks:  # every chunk from the same, outdated code
@@ -460,5 +462,5 @@ def test_the_workflow_refuses_chunks_of_mixed_or_outdated_code(run_j2, tmp_path)
     res = snakemake(wd, "-j1", "uav_collect")
     out = res.stdout + res.stderr
     assert res.returncode != 0 and "Traceback" not in out
-    assert "made by code 000000000000 of rule uav_simulate, but its code now gives" in out
+    assert "made by code 000000000000 of rule uav_simulate (method families nbo)" in out
     assert "rerun rule uav_simulate" in out

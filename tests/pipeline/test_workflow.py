@@ -538,7 +538,7 @@ def test_uav_decision_outputs(run_j2, tiny):
     n_cells = len(cfg["map"]["rows"]["values"]) * len(cfg["map"]["cols"]["values"])
     # RS-MHP N_T=8 and 20, RQMC N_T=8, sigma points, tree search 20 sims (every budget member)
     compared = ["rsmhp_nt8", "rsmhp_nt20", "rqmc_nt8", "sigma", "dpw_s20"]
-    assert set(cfg["frontier"]["budget"]["members"]) <= set(compared)
+    assert set(tiny["frontier"]["budget"]["members"]) <= set(compared)
     assert list(dict.fromkeys(map_df["comparison"])) == [f"{m} − nbo" for m in compared]
     assert len(map_df) == n_cells * len(compared)
     assert (map_df["n_runs"] == cfg["map"]["runs"]).all()

@@ -360,7 +360,7 @@ def test_drill_on_the_tiny_config(run_j2, tmp_path):
     assert set(tables) == native_tables
     # every table is made by target report (the equal-compute study's too) in both runs
     assert not [n for n, t in tables.items() if t["status"] == "missing (emulated)"]
-    assert "plan_ms" in tables["decisions/frontier_summary.csv"]["set aside"]
+    assert "plan_ms" in tables["frontier/explore_summary.csv"]["set aside"]
     for name, t in tables.items():
         same = _content(run_j2 / "results" / name, t["set aside"]) == _content(
             emulated / "results" / name, t["set aside"]

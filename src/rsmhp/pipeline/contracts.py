@@ -279,11 +279,14 @@ def check_codes(
         rule, _, digest = stamp.rpartition(":")
         by_rule.setdefault(rule or "?", {}).setdefault(digest, []).append(path)
     problems = []
-    for rule, digests in sorted(by_rule.items()):
-        now = current(rule) if current is not None and rule != "?" else None
+    for stamp_rule, digests in sorted(by_rule.items()):
+        now = current(stamp_rule) if current is not None and stamp_rule != "?" else None
+        # "uav_simulate+nbo": rule uav_simulate, its jobs of the method family nbo
+        name, _, families = stamp_rule.partition("+")
+        rule = f"{name} (method families {families})" if families else name
         rerun = (
-            f"rerun rule {rule} (e.g. `snakemake -j2 --forcerun {rule}`)"
-            if rule != "?"
+            f"rerun rule {name} (e.g. `snakemake -j2 --forcerun {name}`)"
+            if name != "?"
             else "rerun the rule that produces them"
         )
         if len(digests) > 1:
