@@ -1,11 +1,12 @@
 """Report prose as Markdown templates (Jinja2) beside each study's code.
 
 A study's section text lives in ``src/rsmhp/studies/<study>/*.md``, filled with generated values
-and tables by :func:`render`; no sentence of the report is split across Python string
-literals. The templates are part of the code a rule depends on: :mod:`rsmhp.pipeline.code_digest`
-counts every ``*.md`` file beside a module it covers, so an edit of the prose reruns the rules
-that render it (and no simulation: the ``simulate`` modules of a study do not import its
-section).
+and tables by :func:`render`; no sentence of a section is split across Python string literals
+(the claims' own texts, in the ledger, are still written in each study's ``claims`` module).
+The templates are part of the code a rule depends on: :mod:`rsmhp.pipeline.code_digest` counts
+a ``*.md`` file beside a module as code of the modules that name it (``render(...,
+"section.md")``), so an edit of the prose reruns the rules that render it and no simulation (a
+study's ``simulate`` modules render no template).
 
 Template conventions: ``{{ value }}`` inserts a preformatted string (numbers are formatted in
 Python with :mod:`rsmhp.report.markdown`, not in the template); ``{% if %}`` / ``{% for %}``
