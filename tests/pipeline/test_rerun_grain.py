@@ -12,12 +12,11 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
-from tests.pipeline.test_workflow import ROOT, TINY
+from tests.pipeline.test_workflow import ROOT, TINY, copy_workflow_and_run
 
 # every rule that simulates or times planners (what a presentation edit must never rerun)
 SIMULATIONS = {
@@ -41,16 +40,6 @@ SIMULATIONS = {
     "horizon_lqg_regret",
     "horizon_optimiser",
 }
-
-
-def _copy(run_j2: Path, tmp_path: Path) -> tuple[Path, Path]:
-    wf, run = tmp_path / "wf", tmp_path / "run"
-    wf.mkdir()
-    shutil.copy2(ROOT / "Snakefile", wf / "Snakefile")
-    for d in ("workflow", "config", "src", "paper/exploratory", "paper/superseded", "tests/config"):
-        shutil.copytree(ROOT / d, wf / d, ignore=shutil.ignore_patterns("*.pyc", "*.egg-info"))
-    shutil.copytree(run_j2, run, symlinks=True)
-    return wf, run
 
 
 def _jobs(wf: Path, run: Path, *configfiles: Path) -> list[tuple[str, str]]:
@@ -85,7 +74,7 @@ def _worked_example() -> str:
 
 
 def test_presentation_and_new_methods_rerun_no_other_simulation(run_j2, tmp_path):
-    wf, run = _copy(run_j2, tmp_path)
+    wf, run = copy_workflow_and_run(run_j2, tmp_path)
     assert _jobs(wf, run) == []  # the copy is the same code: nothing to do
 
     # (a) a palette edit: figures, tables and the report; no simulation

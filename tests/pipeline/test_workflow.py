@@ -670,6 +670,19 @@ SIMULATIONS = {
 }
 
 
+def copy_workflow_and_run(run_j2: Path, tmp_path: Path) -> tuple[Path, Path]:
+    """(wf, run): a copy of the workflow (its src/ included: the rules' `code` params are
+    digests of the copy's src/, and the data files it reads at parse time) and of the
+    finished tiny run, under ``tmp_path``."""
+    wf, run = tmp_path / "wf", tmp_path / "run"
+    wf.mkdir()
+    shutil.copy2(ROOT / "Snakefile", wf / "Snakefile")
+    for d in ("workflow", "config", "src", "paper/exploratory", "paper/superseded", "tests/config"):
+        shutil.copytree(ROOT / d, wf / d, ignore=shutil.ignore_patterns("*.pyc", "*.egg-info"))
+    shutil.copytree(run_j2, run, symlinks=True)
+    return wf, run
+
+
 def _dry_run(wf: Path, run: Path) -> tuple[set[str], set[str]]:
     """(every rule `snakemake -n` schedules, the rules among them whose reason is a params
     change), target rules aside."""
@@ -722,12 +735,7 @@ def test_code_edits_rerun_exactly_the_rules_that_import_the_code(run_j2, tmp_pat
     digests of the copy's src/) and of the finished tiny run."""
     from rsmhp.pipeline.code_digest import describe
 
-    wf, run = tmp_path / "wf", tmp_path / "run"
-    wf.mkdir()
-    shutil.copy2(ROOT / "Snakefile", wf / "Snakefile")
-    for d in ("workflow", "config", "src", "paper/exploratory", "paper/superseded", "tests/config"):
-        shutil.copytree(ROOT / d, wf / d, ignore=shutil.ignore_patterns("*.pyc", "*.egg-info"))
-    shutil.copytree(run_j2, run, symlinks=True)
+    wf, run = copy_workflow_and_run(run_j2, tmp_path)
     assert _dry_run(wf, run) == (set(), set())  # the copy is the same code: nothing to do
     scripts, users = _rule_graph(wf, run)
 

@@ -161,7 +161,8 @@ def _analyse(source: bytes, name: str, is_package: bool, disk: _DiskCache | None
 def _analyse_source(source: bytes, name: str, is_package: bool) -> _Module:
     text: list[str] = []
     found: list[ast.AST] = []
-    _render(ast.parse(source), text, found)
+    tree = ast.parse(source)
+    _render(tree, text, found)
     package = name if is_package else name.rpartition(".")[0]
     imports: list[str] = []
     dynamic = False
@@ -191,9 +192,7 @@ def _analyse_source(source: bytes, name: str, is_package: bool) -> _Module:
                 dynamic = True
     wanted = tuple(sorted({m for m in imports if m.split(".")[0] == _PACKAGE}))
     tree_strings = {
-        n.value
-        for n in ast.walk(ast.parse(source))
-        if isinstance(n, ast.Constant) and isinstance(n.value, str)
+        n.value for n in ast.walk(tree) if isinstance(n, ast.Constant) and isinstance(n.value, str)
     }
     templates = tuple(sorted(v for v in tree_strings if v.endswith(".md") and "/" not in v))
     return _Module(_hex("".join(text).encode()), wanted, dynamic, templates)
