@@ -53,7 +53,8 @@ tune: $(STAMP)
 	@echo "config/tuned.yaml written: write and commit a new config/preregistration.yaml before the confirmatory run"
 
 # copy the report of results/ into the tracked paper/ (the only target that changes tracked files)
-# copy the report, its claims (the reference of make verify) and the README's glance table
+# copy the report, its claims (the reference of make verify) and the README's glance table,
+# and add the run's verdicts to paper/history.csv (the fragility lines of later reports)
 publish: $(STAMP)
 	$(BIN)/snakemake -j$(CORES) report $(ARGS)
 	rm -rf paper/figures
@@ -61,6 +62,7 @@ publish: $(STAMP)
 	cp results/paper/replication.md results/paper/appendix.md results/paper/claims.json paper/
 	cp results/paper/figures/*.png paper/figures/
 	$(BIN)/python -m rsmhp.report.readme splice README.md results/paper/glance.md
+	$(BIN)/python -m rsmhp.report.history add results/paper/claims.json --kind implementation
 
 # compare a run with the committed reference paper/claims.json, claim by claim (runs what is
 # missing first); fails if a verdict flips or a key number leaves its tolerance

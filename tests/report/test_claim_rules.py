@@ -7,7 +7,9 @@ Also the rules that combine a paper statement's evidence (rsmhp.report.statement
 from __future__ import annotations
 
 import importlib
+import json
 import pkgutil
+from pathlib import Path
 
 import pytest
 
@@ -23,6 +25,8 @@ from rsmhp.studies.lqg import claims as lqg
 from rsmhp.studies.uav import claims as uav
 
 S, NS, EQ, IN, MX = "supported", "not supported", "equivalent", "inconclusive", "mixed"
+NT = "not tested"
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def _exceedance(cells=40, departing=0, above=0, exact_above=0, detectable=0.1):
@@ -303,7 +307,7 @@ EXAMPLES: dict[str, tuple[Rule, list[tuple[dict, str]]]] = {
     "pp.GENERAL_RULE": (
         pp.GENERAL_RULE,
         [
-            (_counts(), IN),  # no evidence
+            (_counts(), NT),  # no evidence on this kind of setup
             (_counts(**{S: 3}), S),
             (_counts(**{NS: 2}), NS),
             (_counts(**{EQ: 1}), EQ),
@@ -314,10 +318,12 @@ EXAMPLES: dict[str, tuple[Rule, list[tuple[dict, str]]]] = {
     "pp.HEDGED_RULE": (
         pp.HEDGED_RULE,
         [
-            (_counts(**{S: 1, NS: 1, EQ: 2}), S),  # one setting suffices for "may"
+            (_counts(**{S: 1, IN: 2}), S),  # one setting suffices for "may"
+            (_counts(**{S: 1, NS: 1, EQ: 2}), MX),  # shown, and shown absent: disagree
+            (_counts(**{S: 1, EQ: 1}), MX),
             (_counts(**{NS: 1, EQ: 2}), NS),
             (_counts(**{NS: 1, IN: 1}), IN),
-            (_counts(), IN),
+            (_counts(), NT),
         ],
     ),
 }
@@ -360,17 +366,48 @@ def _claim(cid: str, verdict: str, part: str = "paper") -> Claim:
     return Claim(cid, "c", "p", KeyNumber("k", 1.0), verdict, "r", part=part, setup=f"set {cid}")
 
 
-def test_statements_are_judged_on_the_paper_setups_and_hedged_ones_on_all():
-    general = pp.Statement("G", "Sec. X", "A beats B", ("A-1", "V-*"))
+def test_statements_are_judged_on_the_paper_setups_apart_from_variants():
+    general = pp.Statement("G", "Sec. X", "A beats B", ("A-1",), variants=("V-*",))
     claims = [_claim("A-1", EQ), _claim("V-1", S, "beyond"), _claim("V-2", S, "beyond")]
     j = pp.judge(general, claims)
-    assert j.verdict == EQ and [c.id for c in j.alongside] == ["V-1", "V-2"]
-    hedged = pp.Statement("H", "Sec. Y", "NBO may fail", ("A-1", "V-*"), hedged=True)
-    j = pp.judge(hedged, claims)
-    assert j.verdict == S and not j.alongside
-    assert j.scope.startswith("shown on: set V-1 (V-1: supported)")
-    assert "not shown on: set A-1 (A-1: equivalent)" in j.scope
+    assert j.verdict == EQ and j.on_variants == S
+    assert [c.id for c in j.counted] == ["A-1"] and [c.id for c in j.alongside] == ["V-1", "V-2"]
+    assert j.scope == (
+        "absent (equivalent) on the paper's setups (A-1 equivalent); "
+        "shown on the variants (V-1 supported, V-2 supported)"
+    )
+    # a hedged statement: shown on variants only is "not shown on the paper's setups"
+    hedged = pp.Statement("H", "Sec. Y", "NBO may fail", ("A-1", "A-2"), True, variants=("V-*",))
+    j = pp.judge(hedged, [*claims, _claim("A-2", IN)])
+    assert j.verdict == IN and j.on_variants == S
+    assert j.scope.startswith("not shown (inconclusive) on the paper's setups (A-1 equivalent")
+    # shown on one setup of the paper and shown absent on another: mixed, naming the pieces
+    j = pp.judge(hedged, [_claim("A-1", S), _claim("A-2", NS)])
+    assert j.verdict == MX and j.on_variants is None
+    assert j.disagreeing == "supported: A-1; not supported: A-2"
+    # a statement with evidence on variants only is not tested on the paper's setups
+    j = pp.judge(general, claims[1:])
+    assert j.verdict == NT and j.on_variants == S
     assert pp.judge(general, [_claim("B-1", S)]) is None
+
+
+def test_s1_and_s5_restated_on_the_published_claims():
+    """The published claims (paper/claims.json) under the statements' rule: S1 is not shown
+    on the paper's setups but on the footprint variants; S5's evidence disagrees."""
+    data = json.loads((ROOT / "paper/claims.json").read_text(encoding="utf-8"))
+    claims = [Claim.from_dict(c) for c in data["claims"]]
+    by = {j.statement.id: j for j in pp.judge_all(claims)[0]}
+    verdicts = {c.id: c.verdict for c in claims}
+    s1 = by["S1"]
+    assert {c.id for c in s1.counted} == {"DEC-1", "DEC-6", "DEC-8b"}
+    assert {c.id for c in s1.alongside} == {"DEC-7-footprint150", "DEC-8a"}
+    assert s1.verdict == pp.HEDGED_RULE.verdict(pp.evidence_facts(s1.counted))
+    if all(verdicts[i] != S for i in ("DEC-1", "DEC-6", "DEC-8b")):
+        assert s1.verdict != S
+    s5 = by["S5"]
+    pieces = {verdicts[i] for i in ("EST-4", "DEC-4", "UAV-3")}
+    if S in pieces and pieces & {NS, EQ}:
+        assert s5.verdict == MX and s5.disagreeing
 
 
 def test_the_paper_statements_are_well_formed():
@@ -383,5 +420,7 @@ def test_the_paper_statements_are_well_formed():
                 "EST-4", "UAV-1", "UAV-2", "UAV-3", "DEC-1", "DEC-4", "DEC-6"):  # fmt: skip
         assert any(s.matches(cid) for s in pp.STATEMENTS), cid
     assert pp.STATEMENTS[0].matches("DEC-7-footprint150")
+    assert pp.STATEMENTS[0].on_variant("DEC-7-footprint150")
+    assert not pp.STATEMENTS[0].on_variant("DEC-6")
     with pytest.raises(ValueError, match="Q-9"):
         pp.judge_all([_claim("Q-9", S)])

@@ -14,6 +14,7 @@ import pandas as pd
 import pytest
 
 from rsmhp.report import verify as vfy
+from rsmhp.report.findings import MAIN_CLAIMS, MAX_MAIN, anchor, key_text, verdict_text
 from rsmhp.report.ledger import Claim, KeyNumber, Section, claims_records
 from rsmhp.report.markdown import fmt, fmt_ci, markdown_table
 from rsmhp.report.readme import MARK_BEGIN, MARK_END, splice
@@ -154,22 +155,33 @@ def test_section_roundtrip_and_rendering(tmp_path):
         Section.load(tmp_path / "bad.json")
     prov = {"commit": "abc", "config sha256": "0123", "numpy": "2"}
     main = render_report([a, b], prov, statements=STATEMENTS)
-    assert main.index("## Earlier study") < main.index("## Later study")
-    assert main.index("## Claims ledger") < main.index("## Earlier study")
-    # part 1: each statement once with its verdict from its evidence; part 2 apart
-    assert "2 statements of the paper" in main and "(2 claims of evidence;" in main
-    assert "1 supported, 0 not supported, 0 equivalent, 1 inconclusive" in main
-    assert "| S1 | A beats B (Sec. I) | setup of A-1 (A-1: supported) | **supported** |" in main
-    assert "| S2 | C may fail (Sec. II; hedged) | not shown on: setup of Z-1" in main
-    assert "- S2: a note" in main
-    assert "0 claims the report derives itself" in main
-    assert main.index("**Symbols.**") < main.index("### Part 1")
-    assert "1 of the 2 key numbers are bitwise reproducible" in main
-    assert "| A-1 | A beats B | setup of A-1 | paired difference: -0.300 [-0.500, -0.100] m" in main
-    assert "CI below 0: supported" in main and "| t |" not in main
-    app = render_appendix([a, b], {"seed": 2}, prov)
-    assert "### Z-1 (inconclusive)" in app and "| t |" in app and "seed: 2" in app
-    assert "- Part: the paper; setup: setup of Z-1" in app
+    # the answer first, then the statements, the main claims, the studies' index
+    order = [
+        "## What we found",
+        "## The paper's statements",
+        "## The main claims",
+        "## The studies",
+    ]
+    assert [main.index(h) for h in order] == sorted(main.index(h) for h in order)
+    assert "## Earlier study" not in main and "Body of the later study" not in main
+    assert "| Earlier study | – | appendix C1 |" in main
+    assert "| Later study | [f](figures/f.png) | appendix C2 |" in main
+    # each statement once, judged on the paper's setups; the hedged one with no piece shown
+    assert "2 statements of the paper" in main
+    assert (
+        "On the paper's setups: 1 supported, 0 not supported, 0 equivalent, 1 inconclusive" in main
+    )
+    assert (
+        "| S1 | A beats B (Sec. I) | **supported**: [A-1](appendix.md#a-1) supported | – |" in main
+    )
+    assert "| S2 | C may fail (Sec. II; hedged) | **inconclusive**: [Z-1](appendix.md#z-1)" in main
+    assert "1 of the 2" not in main and "Of the 2 key numbers 1 reproduce bitwise" in main
+    assert "CI below 0: supported" not in main  # rules are in the appendix, linked
+    app = render_appendix([a, b], {"seed": 2}, prov, statements=STATEMENTS)
+    assert "### Z-1\n\n- Verdict: **inconclusive**" in app and "| t |" in app and "seed: 2" in app
+    assert "- Part: the paper; setup: setup of Z-1" in app and "- S2: a note" in app
+    assert "## C1. Earlier study\n\nBody." in app and "Body of the later study" in app
+    assert "CI below 0: supported" in app
     assert (
         "(statistically reproducible)" in app
         and "(bitwise reproducible)" in app
@@ -179,7 +191,7 @@ def test_section_roundtrip_and_rendering(tmp_path):
     assert [r["id"] for r in recs] == ["A-1", "Z-1"]
     assert Claim.from_dict(json.loads(json.dumps(recs[1]))) == a.claims[0]
     glance = glance_table([c for s in (b, a) for c in s.claims], STATEMENTS)
-    assert glance.count("\n") == 3 and "| S2 | paper (Sec. II): C may fail |" in glance
+    assert glance.count("\n") == 3 and "| S2 | C may fail (Sec. II) | inconclusive (Z-1" in glance
     # a claim of the paper that no statement lists is refused (it would be counted nowhere)
     with pytest.raises(ValueError, match="Q-1"):
         render_report(
@@ -187,9 +199,9 @@ def test_section_roundtrip_and_rendering(tmp_path):
         )
 
 
-def test_beyond_claims_and_contrary_evidence_are_in_part_two():
-    """Claims of part 'beyond' are counted apart; a variant listed under a general statement
-    is shown beside it but does not enter its verdict; contrary cells are printed."""
+def test_variants_checks_and_contrary_evidence_are_apart():
+    """Variant evidence is judged apart from the paper's setups; checks of our machinery
+    have an appendix part and a count of their own; contrary cells are printed."""
     s = Section(
         "s",
         "Study",
@@ -199,15 +211,24 @@ def test_beyond_claims_and_contrary_evidence_are_in_part_two():
             _claim("A-1", "supported", -0.3, -0.5, -0.1),
             _claim("A-2", "not supported", 0.3, 0.1, 0.5, contrary="cell q = 4: +0.26 m"),
             _claim("V-1", "supported", -0.3, -0.5, -0.1, part="beyond"),
+            replace(_claim("C-1", "supported", -0.3, -0.5, -0.1, part="beyond"), check=True),
         ],
     )
-    stmts = (Statement("S1", "Sec. I", "A beats B", ("A-*", "V-1")),)
+    stmts = (Statement("S1", "Sec. I", "A beats B", ("A-*",), variants=("V-1",)),)
     main = render_report([s], {}, statements=stmts)
-    assert "| S1 | A beats B (Sec. I) | setup of A-1 (A-1: supported); setup of A-2 (A-2: " in main
-    assert "**mixed**" in main  # A-1 supported, A-2 not supported: the evidence disagrees
-    assert "on variants, not counted: setup of V-1 (V-1: supported)" in main
-    assert "1 claims the report derives itself or tests on model variants: 1 supported" in main
-    assert "| cell q = 4: +0.26 m |" in main
+    assert "| S1 | A beats B (Sec. I) | **mixed**: [A-1](appendix.md#a-1) supported, " in main
+    assert "| **supported**: [V-1](appendix.md#v-1) supported |" in main
+    assert "1 checks of our machinery in a part of their own" in main
+    app = render_appendix([s], {}, {}, statements=stmts)
+    assert "- S1 (mixed): supported: A-1; not supported: A-2" in app
+    assert "2 claims test the paper's statements on its setups: 1 supported, 1 not supported" in app
+    assert "1 claims go beyond the paper" in app and ": 1 supported, 0 not supported" in app
+    assert "1 checks of our simulation" in app
+    ledger = app[app.index("### A2") : app.index("### A3")]
+    checks = app[app.index("### A3") : app.index("### A4")]
+    assert "| C-1 |" in checks and "| C-1 |" not in ledger and "| V-1 |" in ledger
+    assert "| cell q = 4: +0.26 m |" in ledger
+    assert "- Verdict: **supported** (a check of our machinery)" in app
 
 
 def test_splice_replaces_only_the_marked_block():
@@ -277,29 +298,35 @@ def test_verify_cli(tmp_path, capsys):
 
 
 def test_published_report_matches_its_claims_and_the_readme():
-    """paper/ is what `make publish` copied from one run: the main text is <= 55 KB, has no
-    nan/inf, lists exactly the claims of paper/claims.json with their verdicts, and the
-    README's results block is the glance table of the same claims (generated, not copied)."""
+    """paper/ is what `make publish` copied from one run: the main text is one page (<= 25 KB)
+    that opens with the findings and the summary figure, shows at most ten claims (those of
+    MAIN_CLAIMS, with their verdicts) and every statement; the appendix has every claim; no
+    nan/inf; the README's results block is the glance table of the same claims."""
     main = (ROOT / "paper/replication.md").read_text(encoding="utf-8")
     appendix = (ROOT / "paper/appendix.md").read_text(encoding="utf-8")
     data = json.loads((ROOT / "paper/claims.json").read_text(encoding="utf-8"))
     claims = [Claim.from_dict(c) for c in data["claims"]]
-    # the two-part ledger with every rule and the contrary evidence next to its claim
-    # eight study sections (the confirmatory protocol and the optimiser split added 4.8 KB,
-    # 4.3 KB moved to the appendix in exchange) and a two-part ledger (34 claims)
-    assert len(main.encode()) <= 55_000
+    assert len(main.encode()) <= 25_000
+    assert main.index("## What we found") < main.index("](figures/scenarios_best.png)")
+    assert main.index("](figures/scenarios_best.png)") < main.index("## The paper's statements")
+    found = main[main.index("## What we found") : main.index("![")]
+    sentences = re.findall(r"^\d+\. ", found, flags=re.MULTILINE)
+    assert 1 <= len(sentences) <= 7
     for text in (main, appendix):
         assert not re.search(r"\b(nan|inf)\b", text, flags=re.IGNORECASE)
+    by_id = {c.id: c for c in claims}
+    table = main[main.index("## The main claims") : main.index("## The studies")]
+    rows = [line for line in table.splitlines() if line.startswith("| ") and "---" not in line]
+    assert 1 < len(rows) <= MAX_MAIN + 1  # header + at most ten claims
+    for m in MAIN_CLAIMS:
+        for _, cid in m.setups:
+            assert f"[{cid}](appendix.md#{anchor(cid)}): {key_text(by_id[cid])} → " in table
+            assert f"**{verdict_text(by_id[cid])}**" in table
     for c in claims:
-        assert f"| {c.id} | {c.claim.replace('|', chr(92) + '|')} |" in main
-        assert f"### {c.id} ({c.verdict})" in appendix
+        assert f"### {c.id}\n\n- Verdict: **{verdict_text(c)}**" in appendix
+        assert f"| {c.id} | {c.claim.replace('|', chr(92) + '|')} |" in appendix
     for st in data["statements"]:
-        assert f"| {st['id']} | " in main and st["verdict"] in main
-    ledger_ids = re.findall(r"^\| ([A-Z]+-[0-9A-Za-z-]+) \|", main, flags=re.MULTILINE)
-    # part 1's evidence, then part 2 (beyond the paper)
-    assert ledger_ids == [c.id for c in claims if c.part == "paper"] + [
-        c.id for c in claims if c.part == "beyond"
-    ]
+        assert f"| {st['id']} | " in main and f"**{st['verdict']}**" in main
     readme = (ROOT / "README.md").read_text(encoding="utf-8")
     block = readme[readme.index(MARK_BEGIN) + len(MARK_BEGIN) : readme.index(MARK_END)]
     assert block.strip() == glance_table(claims).strip()

@@ -4,11 +4,18 @@
 # tracked files. `make verify` (rule verify) compares claims.json with paper/claims.json.
 
 
+HISTORY = "paper/history.csv"
+
+
 rule report:
     """The replication report (main text, appendix, figures, claims) from every section."""
     input:
         sections=list(REPORT_SECTIONS.values()),
         figures=expand("results/figures/{name}.png", name=REPORT_FIGURES),
+        # every earlier verdict of each claim (committed; make publish adds this run's)
+        history=[HISTORY] if os.path.exists(HISTORY) else [],
+        # the best family per cell of the summary figure (scenarios study)
+        best=["results/scenarios/best.csv"] if "scenarios" in REPORT_SECTIONS else [],
     output:
         report="results/paper/replication.md",
         appendix="results/paper/appendix.md",

@@ -6,9 +6,12 @@ import json
 import shutil
 from pathlib import Path
 
+import pandas as pd
+
 from rsmhp.pipeline.io import write_text
 from rsmhp.pipeline.protocol import file_commit
 from rsmhp.pipeline.script import rule_logging
+from rsmhp.report.history import load_history
 from rsmhp.report.ledger import Section, claims_records
 from rsmhp.report.provenance import code_provenance, provenance
 from rsmhp.report.render import glance_table, render_appendix, render_report, statements_records
@@ -41,10 +44,15 @@ with rule_logging(snakemake) as log:
     summary["code (rule digest)"] = ", ".join(
         f"{rule} {' / '.join(e['recorded'])}" for rule, e in prov["code"]["rules"].items()
     )
-    main = render_report(sections, summary)
+    # every verdict each claim had before (published runs, the portability drill, other
+    # seed streams): the fragility lines; the best family per cell: the summary figure's table
+    history = load_history(snakemake.input.history[0]) if snakemake.input.history else None
+    best = pd.read_csv(snakemake.input.best[0]) if snakemake.input.best else None
+    main = render_report(sections, summary, best=best, history=history)
     write_text(main, snakemake.output.report)
     write_text(
-        render_appendix(sections, snakemake.params.config, summary), snakemake.output.appendix
+        render_appendix(sections, snakemake.params.config, summary, history=history),
+        snakemake.output.appendix,
     )
     records = claims_records(sections)
     claims = [c for s in sorted(sections, key=lambda s: (s.order, s.key)) for c in s.claims]

@@ -33,9 +33,10 @@ __all__ = [
 #: difference is smaller than m (``equivalent``), or none of these (``inconclusive``)
 VERDICTS = ("supported", "not supported", "equivalent", "inconclusive")
 
-#: verdicts of a paper statement with several pieces of evidence: a claim verdict, or
-#: ``mixed`` when its pieces of evidence disagree (:mod:`rsmhp.report.statements`)
-STATEMENT_VERDICTS = (*VERDICTS, "mixed")
+#: verdicts of a paper statement with several pieces of evidence: a claim verdict, ``mixed``
+#: when its pieces of evidence disagree, ``not tested`` on a kind of setup without evidence
+#: (:mod:`rsmhp.report.statements`)
+STATEMENT_VERDICTS = (*VERDICTS, "mixed", "not tested")
 
 #: the two parts of the ledger: ``paper`` (a statement of the paper tested on the paper's own
 #: setup) and ``beyond`` (claims the report derives itself, and tests on model variants)
@@ -70,6 +71,12 @@ class KeyNumber:
     #: value over that family (:func:`rsmhp.report.verdicts.holm_correct`)
     p_value: float | None = None
     p_holm: float | None = None
+    #: ``n``: the number of independent units the CI rests on (runs, belief states), where
+    #: the key number is a mean over them; ``margin``: the rule's margin Δ (equivalence or
+    #: non-inferiority), fixed before the run. Both feed the runs needed at 80% power
+    #: (:func:`rsmhp.report.power.runs_needed`); ``None`` where they do not apply.
+    n: int | None = None
+    margin: float | None = None
 
     def __post_init__(self) -> None:
         if self.reproducible not in REPRODUCIBILITY:
@@ -85,6 +92,14 @@ class KeyNumber:
             raise ValueError(f"key number {self.name!r}: CI [{self.ci_low}, {self.ci_high}]")
         if self.reproducible == "statistical" and self.ci_low is None:
             raise ValueError(f"key number {self.name!r}: a statistical number needs its CI")
+        if self.n is not None and not (isinstance(self.n, int) and self.n >= 2):
+            raise ValueError(f"key number {self.name!r}: n must be an integer >= 2, got {self.n!r}")
+        if self.margin is not None and not (
+            isinstance(self.margin, int | float) and math.isfinite(self.margin) and self.margin > 0
+        ):
+            raise ValueError(
+                f"key number {self.name!r}: margin must be a finite number > 0, got {self.margin!r}"
+            )
 
     @property
     def has_ci(self) -> bool:
@@ -110,7 +125,8 @@ class Claim:
     tested on (the paper's, or a named variant); which statement of the paper a claim is
     evidence for is said once, in :data:`rsmhp.report.statements.STATEMENTS`. ``contrary`` names
     every cell or setting whose CI lies on the side opposite to the claim (printed next to
-    the claim in the main text)."""
+    the claim in the main text). ``check`` marks a check of our own machinery against a
+    closed form (counted apart from the findings)."""
 
     id: str
     claim: str
@@ -123,6 +139,9 @@ class Claim:
     part: str = "paper"
     setup: str = "paper"
     contrary: str = ""
+    #: a check of our own machinery (simulation, estimator or optimiser against a closed
+    #: form), not a finding: counted apart from the findings, in an appendix part of its own
+    check: bool = False
 
     def __post_init__(self) -> None:
         if self.verdict not in VERDICTS:

@@ -1,4 +1,4 @@
-"""The replication report: renders the claims ledger, one section per study and the appendix.
+"""The replication report: the answer on one page (main text) and everything behind it (appendix).
 
 Each aggregation rule writes a :class:`rsmhp.report.ledger.Section` as JSON
 (``results/report/<key>.json``): its Markdown body (figures referenced as
@@ -15,11 +15,16 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 from typing import Any
 
+import pandas as pd
 import yaml
 
+from rsmhp.report.findings import MAIN_CLAIMS, found_values, key_text, link, main_rows, verdict_text
+from rsmhp.report.history import fragility
 from rsmhp.report.ledger import STATEMENT_VERDICTS, VERDICTS, Claim, Section
 from rsmhp.report.markdown import escape, fmt, fmt_ci
+from rsmhp.report.power import runs_text
 from rsmhp.report.statements import GENERAL_RULE, HEDGED_RULE, Judgement, Statement, judge_all
+from rsmhp.report.templates import render as render_template
 
 __all__ = [
     "SYMBOLS",
@@ -60,24 +65,26 @@ def claims_table(claims: Iterable[Claim]) -> str:
     return "\n".join(lines)
 
 
-def statements_table(judgements: Iterable[Judgement]) -> str:
-    """Part one of the ledger: each statement of the paper once, its evidence (counted, and
-    on variants alongside) and one verdict (the rules that combine the evidence are printed
-    once, above the table: :data:`rsmhp.report.statements.GENERAL_RULE`, ``HEDGED_RULE``)."""
+def statements_table(judgements: Iterable[Judgement], appendix: str = "appendix.md") -> str:
+    """The paper's statements, each once, judged on the paper's own setups and, apart, on
+    variants: the verdict of each kind of setup with its pieces of evidence (linked)."""
     lines = [
-        "| | the paper says | evidence (setup: verdict) | verdict |",
+        "| | the paper says | on the paper's setups | on variants |",
         "|---|---|---|---|",
     ]
+
+    def cell(verdict: str | None, claims: Sequence[Claim]) -> str:
+        if verdict is None:
+            return "–"
+        pieces = ", ".join(f"{link(c.id, appendix)} {c.verdict}" for c in claims)
+        return f"**{verdict}**" + (f": {pieces}" if pieces else "")
+
     for j in judgements:
         st = j.statement
-        evidence = j.scope or "–"
-        if j.alongside:
-            evidence += "; on variants, not counted: " + "; ".join(
-                f"{c.setup} ({c.id}: {c.verdict})" for c in j.alongside
-            )
         lines.append(
             f"| {st.id} | {escape(st.says)} ({escape(st.where)}"
-            f"{'; hedged' if st.hedged else ''}) | {escape(evidence)} | **{j.verdict}** |"
+            f"{'; hedged' if st.hedged else ''}) | {cell(j.verdict, j.counted)} "
+            f"| {cell(j.on_variants, j.alongside)} |"
         )
     return "\n".join(lines)
 
@@ -91,6 +98,7 @@ def statements_records(judgements: Iterable[Judgement]) -> list[dict[str, Any]]:
             "says": j.statement.says,
             "hedged": j.statement.hedged,
             "verdict": j.verdict,
+            "on_variants": j.on_variants,
             "rule": j.rule,
             "counted": [c.id for c in j.counted],
             "alongside": [c.id for c in j.alongside],
@@ -101,28 +109,37 @@ def statements_records(judgements: Iterable[Judgement]) -> list[dict[str, Any]]:
 
 def glance_table(claims: Iterable[Claim], statements: Sequence[Statement] | None = None) -> str:
     """The README's "results at a glance": the paper's statements (default
-    :data:`rsmhp.report.statements.STATEMENTS`) with their verdicts, then the claims beyond the
-    paper (id, claim, key number with CI, verdict)."""
+    :data:`rsmhp.report.statements.STATEMENTS`) with their verdicts on the paper's setups and on
+    variants, then the benchmark's own main claims (:data:`rsmhp.report.findings.MAIN_CLAIMS`
+    without a statement), their verdicts per setup."""
     claims = list(claims)
+    by_id = {c.id: c for c in claims}
     judgements, _ = judge_all(claims, statements)
-    lines = ["| | claim | our number (95% CI) | verdict |", "|---|---|---|---|"]
+    lines = [
+        "| | the paper says | on the paper's setups | on variants |",
+        "|---|---|---|---|",
+    ]
     for j in judgements:
-        nums = "; ".join(f"{c.id}: {_ledger_number(c)}" for c in j.counted)
-        pieces = (
-            " (" + ", ".join(f"{c.id} {c.verdict}" for c in j.counted) + ")"
-            if len(j.counted) > 1
-            else ""
+        pieces = ", ".join(f"{c.id} {c.verdict}" for c in j.counted)
+        var = (
+            f"{j.on_variants} ({', '.join(f'{c.id} {c.verdict}' for c in j.alongside)})"
+            if j.on_variants
+            else "–"
         )
         lines.append(
-            f"| {j.statement.id} | paper ({j.statement.where}): {escape(j.statement.says)} "
-            f"| {escape(nums)} | {j.verdict}{pieces} |"
+            f"| {j.statement.id} | {escape(j.statement.says)} ({escape(j.statement.where)}) "
+            f"| {j.verdict} ({pieces}) | {escape(var)} |"
         )
-    for c in claims:
-        if c.part == "beyond":
-            lines.append(
-                f"| {c.id} | beyond the paper: {escape(c.claim)} "
-                f"| {escape(_ledger_number(c))} | {c.verdict} |"
+    ours = [m for m in MAIN_CLAIMS if not m.statement and any(i in by_id for _, i in m.setups)]
+    if ours:
+        lines += ["", "| | the benchmark's claim | verdict per setup |", "|---|---|---|"]
+        for m in ours:
+            per = "; ".join(
+                f"{lab}: {verdict_text(by_id[i])} ({escape(key_text(by_id[i]))})"
+                for lab, i in m.setups
+                if i in by_id
             )
+            lines.append(f"| {m.name} | {escape(m.says)} | {per} |")
     return "\n".join(lines)
 
 
@@ -168,50 +185,90 @@ def _counts(verdicts: Iterable[str], vocabulary: tuple[str, ...]) -> str:
     )
 
 
-def _ledger(claims: list[Claim], statements: Sequence[Statement] | None) -> list[str]:
-    """The two parts of the claims ledger (main text)."""
-    judgements, untested = judge_all(claims, statements)
-    paper = [c for c in claims if c.part == "paper"]
-    beyond = [c for c in claims if c.part == "beyond"]
-    n_bit = sum(c.key.reproducible == "bitwise" for c in claims)
-    notes = [f"- {j.statement.id}: {j.statement.note}" for j in judgements if j.statement.note]
+#: the summary figure the main text opens with (the scenarios study draws it)
+SUMMARY_FIGURE = "scenarios_best"
+
+
+def _statements_part(
+    judgements: Sequence[Judgement], untested: Sequence[str], appendix: str
+) -> list[str]:
+    on_var = [j for j in judgements if j.on_variants is not None]
     return [
-        "## Claims ledger",
+        "## The paper's statements, judged where the paper made them",
         "",
-        SYMBOLS,
-        "",
-        VERDICT_POLICY,
-        f" {n_bit} of the {len(claims)} key numbers are bitwise reproducible (same code, "
-        f"config, versions, BLAS and CPU flags), {len(claims) - n_bit} statistically (UAV "
-        "closed loop and optimiser); `make verify` compares a run with the committed "
-        "reference, `paper/claims.json`.",
-        "",
-        "### Part 1: the paper's claims",
-        "",
-        f"{len(judgements)} statements of the paper, each tested on the paper's own setups "
-        f"({len(paper)} claims of evidence; a hedged statement also on variants): "
+        f"{len(judgements)} statements of the paper, each judged on the paper's own setups "
+        "(the oven LQG, the estimator problems, the UAV reconstruction with its sensor) and, "
+        "apart, on our variants (footprint sensors, costs outside a proposition's premise); "
+        "a statement's verdict is the one on the paper's setups. On the paper's setups: "
         + _counts((j.verdict for j in judgements), STATEMENT_VERDICTS)
+        + (
+            f"; on variants ({len(on_var)} statements tested there): "
+            + _counts((j.on_variants for j in on_var), STATEMENT_VERDICTS)
+            if on_var
+            else ""
+        )
         + f". A general statement's verdict, {GENERAL_RULE.text()}. A hedged one ('may'): "
-        f"{HEDGED_RULE.text()}; the table names where it was and was not shown."
-        + (f" Not tested in this run: {', '.join(untested)}." if untested else ""),
+        f"{HEDGED_RULE.text()}."
+        + (f" Not tested in this run: {', '.join(untested)}." if untested else "")
+        + " Notes (S1, S2: a gap in the proof of Prop. 1, S5): "
+        + f"[appendix A1]({appendix}#a1-the-papers-statements).",
         "",
-        statements_table(judgements),
-        "",
-        *(["Notes on the statements:", "", *notes, ""] if notes else []),
-        "Evidence on the paper's setups:",
-        "",
-        claims_table(paper),
-        "",
-        "### Part 2: beyond the paper",
-        "",
-        f"{len(beyond)} claims the report derives itself or tests on model variants: "
-        + _counts((c.verdict for c in beyond), VERDICTS)
-        + ". They are not the paper's claims; where one bears on a statement of the paper it "
-        "is listed there as well.",
-        "",
-        claims_table(beyond),
+        statements_table(judgements, appendix),
         "",
     ]
+
+
+def _main_claims_part(
+    claims: Sequence[Claim], history: pd.DataFrame | None, appendix: str
+) -> list[str]:
+    rows = main_rows(claims, appendix)
+    shown = {cid for m in MAIN_CLAIMS for _, cid in m.setups}
+    fragile = []
+    if history is not None:
+        for c in claims:
+            if c.id in shown and (line := fragility(c, history)):
+                fragile.append(f"- {link(c.id, appendix)} ({c.verdict}): {line}")
+    n_other = sum(1 for c in claims if c.id not in shown and not c.check)
+    n_checks = sum(c.check for c in claims)
+    table = [
+        "| | claim | per setup: key number (95% CI) → verdict; n, n for 80% power |",
+        "|---|---|---|",
+    ]
+    for r in rows:
+        tag = f" ({r['statement']})" if r["statement"] else ""
+        table.append(f"| {r['name']}{tag} | {escape(r['says'])} | {'<br>'.join(r['setups'])} |")
+    return [
+        f"## The main claims ({len(rows)})",
+        "",
+        VERDICT_POLICY
+        + " n is the number of paired runs (or belief states) behind a CI; 'for 80% power': "
+        "the n at which the rule would decide with 80% probability if the true difference were "
+        "the estimate (normal approximation). Each claim's rule, all its numbers and what was "
+        f"left out are in the appendix (linked). {n_other} further claims are in the appendix "
+        f"ledger, and {n_checks} checks of our machinery in a part of their own.",
+        "",
+        *table,
+        "",
+        *(
+            [
+                "**Fragile verdicts** (changed across published runs, machines or seed streams; "
+                "`paper/history.csv`):",
+                "",
+                *fragile,
+                "",
+            ]
+            if fragile
+            else []
+        ),
+    ]
+
+
+def _studies_part(sections: Sequence[Section]) -> list[str]:
+    lines = ["## The studies", "", "| study | figures | details |", "|---|---|---|"]
+    for i, s in enumerate(sections, start=1):
+        figs = ", ".join(f"[{f}](figures/{f}.png)" for f in s.figures) or "–"
+        lines.append(f"| {s.title} | {figs} | appendix C{i} |")
+    return [*lines, ""]
 
 
 def render_report(
@@ -219,24 +276,49 @@ def render_report(
     provenance: Mapping[str, str],
     appendix: str = "appendix.md",
     statements: Sequence[Statement] | None = None,
+    best: pd.DataFrame | None = None,
+    history: pd.DataFrame | None = None,
 ) -> str:
-    """The main text: introduction, claims ledger, one section per study (in ``order``), a
-    short provenance note; details go to :func:`render_appendix` (file ``appendix``)."""
+    """The main text on one page: "What we found" (the answer, each sentence linked to its
+    claims) with the summary figure, the paper's statements judged on its setups and on
+    variants, the main claims (:data:`rsmhp.report.findings.MAIN_CLAIMS`) with their fragile
+    verdicts, an index of the studies and a provenance line; everything else goes to
+    :func:`render_appendix` (file ``appendix``). ``best``: the best-family table of the
+    summary figure; ``history``: :func:`rsmhp.report.history.load_history`."""
     sections = sorted(sections, key=lambda s: (s.order, s.key))
-    all_claims = [c for s in sections for c in s.claims]
+    claims = [c for s in sections for c in s.claims]
+    judgements, untested = judge_all(claims, statements)
+    found = render_template(
+        "rsmhp.report", "findings.md", **found_values(judgements, claims, best, appendix)
+    ).strip()
+    figure = []
+    if any(SUMMARY_FIGURE in s.figures for s in sections):
+        figure = [
+            f"![Best family per scenario, budget and horizon](figures/{SUMMARY_FIGURE}.png)",
+            "",
+            "*The family with the lowest closed-loop error per cell (solid: better than every "
+            "other family, paired 95% CI; hatched: tied, with the number of families tied).*",
+            "",
+        ]
+    n_bit = sum(c.key.reproducible == "bitwise" for c in claims)
     parts = [
         "# rsmhp replication report",
         "",
         "Replication of Ragi & Mittelmann, *Random-Sampling Monte-Carlo Tree Search Methods for "
         "Cost Approximation in Long-Horizon Optimal Control*, IEEE Control Systems Letters 5(5), "
-        "2021. Written by the pipeline (`snakemake report`) from `results/` of one run; tables, "
-        f"claim details, parameters and provenance are in [{appendix}]({appendix}).",
+        "2021, written by the pipeline from one run. This page gives the answer; every claim "
+        "with its rule and numbers, each study's section, tables, parameters and provenance are "
+        f"in [{appendix}]({appendix}). Of the {len(claims)} key numbers {n_bit} reproduce "
+        f"bitwise, {len(claims) - n_bit} statistically (`make verify`).",
         "",
-        *_ledger(all_claims, statements),
-    ]
-    for s in sections:
-        parts += [f"## {s.title}", "", s.body.strip(), ""]
-    parts += [
+        "## What we found",
+        "",
+        found,
+        "",
+        *figure,
+        *_statements_part(judgements, untested, appendix),
+        *_main_claims_part(claims, history, appendix),
+        *_studies_part(sections),
         "## Provenance",
         "",
         "This run: commit `{}`{}, config sha256 `{}`, Python {}, numpy {}, numba {}, BLAS {}, "
@@ -261,44 +343,119 @@ def render_report(
 _REPRO_TEXT = {"bitwise": "bitwise reproducible", "statistical": "statistically reproducible"}
 
 
+def _ledger_part(
+    claims: Sequence[Claim],
+    statements: Sequence[Statement] | None,
+    history: pd.DataFrame | None,
+) -> list[str]:
+    judgements, _ = judge_all(claims, statements)
+    notes = [f"- {j.statement.id}: {j.statement.note}" for j in judgements if j.statement.note]
+    mixed = [f"- {j.statement.id} (mixed): {j.disagreeing}" for j in judgements if j.disagreeing]
+    paper = [c for c in claims if c.part == "paper" and not c.check]
+    beyond = [c for c in claims if c.part == "beyond" and not c.check]
+    checks = [c for c in claims if c.check]
+    fragile = []
+    if history is not None:
+        fragile = [
+            f"- {c.id} ({c.verdict}): {line}" for c in claims if (line := fragility(c, history))
+        ]
+    return [
+        "## A. The ledger",
+        "",
+        SYMBOLS,
+        "",
+        VERDICT_POLICY,
+        "",
+        "### A1. The paper's statements",
+        "",
+        f"A general statement's verdict, {GENERAL_RULE.text()}. A hedged one ('may'): "
+        f"{HEDGED_RULE.text()}.",
+        "",
+        statements_table(judgements, ""),
+        "",
+        *(["Where the evidence disagrees:", "", *mixed, ""] if mixed else []),
+        *(["Notes on the statements:", "", *notes, ""] if notes else []),
+        "### A2. Findings",
+        "",
+        f"{len(paper)} claims test the paper's statements on its setups: "
+        + _counts((c.verdict for c in paper), VERDICTS)
+        + f". {len(beyond)} claims go beyond the paper (our derivations, comparisons and model "
+        "variants; the checks of our machinery are not among them): "
+        + _counts((c.verdict for c in beyond), VERDICTS)
+        + ".",
+        "",
+        claims_table(paper + beyond),
+        "",
+        "### A3. Checks of our machinery",
+        "",
+        f"{len(checks)} checks of our simulation, estimators and optimiser against closed forms "
+        "(they test the implementation, not a finding; counted apart): "
+        + _counts((c.verdict for c in checks), VERDICTS)
+        + ".",
+        "",
+        claims_table(checks),
+        "",
+        "### A4. Fragile verdicts",
+        "",
+        "Every claim whose verdict changed across the published runs, the portability drill "
+        "(an emulated other CPU) or seed streams (exploratory against confirmatory), from "
+        "`paper/history.csv`" + (":" if fragile else ": none."),
+        "",
+        *([*fragile, ""] if fragile else []),
+    ]
+
+
 def render_appendix(
-    sections: Iterable[Section], config: Mapping[str, Any], provenance: Mapping[str, str]
+    sections: Iterable[Section],
+    config: Mapping[str, Any],
+    provenance: Mapping[str, str],
+    statements: Sequence[Statement] | None = None,
+    history: pd.DataFrame | None = None,
 ) -> str:
-    """The appendix: every claim in detail (rule, all measured numbers, what was left out),
-    each study's tables and secondary results, the parameters of the run, provenance."""
+    """The appendix: the whole ledger (statements with notes, every finding per model, the
+    checks of our machinery apart, the fragile verdicts), every claim in detail (rule, all
+    measured numbers, what was left out), each study's section with its tables, the
+    parameters of the run and provenance."""
     sections = sorted(sections, key=lambda s: (s.order, s.key))
+    claims = [c for s in sections for c in s.claims]
     parts = [
         "# rsmhp replication report: appendix",
         "",
         "Details behind [the main text](replication.md), from the same run.",
         "",
-        "## A. Claims in detail",
+        *_ledger_part(claims, statements, history),
+        "## B. Claims in detail",
         "",
     ]
-    for s in sections:
-        for c in s.claims:
-            parts += [
-                f"### {c.id} ({c.verdict})",
-                "",
-                f"- Claim: {c.claim}",
-                f"- Part: {'the paper' if c.part == 'paper' else 'beyond the paper'}; "
-                f"setup: {c.setup}",
-                f"- Paper: {c.paper}",
-                f"- Key number: {c.key.text()} ({_REPRO_TEXT[c.key.reproducible]})",
-                f"- Verdict rule: {c.rule}",
-            ]
-            if c.measured:
-                parts.append(f"- Measured: {c.measured}")
-            if c.contrary:
-                parts.append(f"- Contrary evidence: {c.contrary}")
-            if c.dropped:
-                parts.append(f"- Left out: {c.dropped}")
-            parts.append("")
+    for c in claims:
+        parts += [
+            f"### {c.id}",
+            "",
+            f"- Verdict: **{verdict_text(c)}**"
+            + (" (a check of our machinery)" if c.check else ""),
+            f"- Claim: {c.claim}",
+            f"- Part: {'the paper' if c.part == 'paper' else 'beyond the paper'}; setup: {c.setup}",
+            f"- Paper: {c.paper}",
+            f"- Key number: {c.key.text()} ({_REPRO_TEXT[c.key.reproducible]})",
+            f"- Verdict rule: {c.rule}",
+        ]
+        if c.key.n is not None:
+            parts.append(f"- Runs: {runs_text(c.key)}")
+        if c.measured:
+            parts.append(f"- Measured: {c.measured}")
+        if c.contrary:
+            parts.append(f"- Contrary evidence: {c.contrary}")
+        if c.dropped:
+            parts.append(f"- Left out: {c.dropped}")
+        if history is not None and (line := fragility(c, history)):
+            parts.append(f"- Fragile: {line}")
+        parts.append("")
     for i, s in enumerate(sections, start=1):
+        parts += [f"## C{i}. {s.title}", "", s.body.strip(), ""]
         if s.appendix.strip():
-            parts += [f"## B{i}. {s.title}", "", s.appendix.strip(), ""]
+            parts += [s.appendix.strip(), ""]
     parts += [
-        "## C. Parameters of this run",
+        "## D. Parameters of this run",
         "",
         "The validated configuration (defaults filled in), exactly as the pipeline used it:",
         "",
@@ -306,7 +463,7 @@ def render_appendix(
         yaml.safe_dump(dict(config), sort_keys=False).strip(),
         "```",
         "",
-        "## D. Provenance",
+        "## E. Provenance",
         "",
         "Host and date are in `results/provenance.json` (they change every run).",
         "",

@@ -1,19 +1,19 @@
-r"""The paper's statements, each once, with the claims that are its evidence and one verdict.
+r"""The paper's statements, each once, with the claims that are its evidence, judged where the
+paper made them.
 
-The ledger has two parts (:data:`rsmhp.report.ledger.PARTS`). Part one lists the statements of the
-paper (:data:`STATEMENTS`): what the paper says and where, in our words; the claims that test
-it (by id, in :attr:`Statement.evidence`); and one verdict, given by a rule over the verdicts
-of that evidence (:data:`GENERAL_RULE` or, for a hedged sentence such as "NBO may generate
-severely sub-optimal controls", :data:`HEDGED_RULE`). Part two holds the claims the report
-derives itself and the tests on model variants (claims with ``part == "beyond"``); a variant
-test may also be listed as evidence under a statement, where it is shown as such.
+Each statement of the paper (:data:`STATEMENTS`) names the claims that test it on **the
+paper's own setups** (:attr:`Statement.evidence`: the oven LQG of Sec. III-A, the estimator
+problems, the UAV reconstruction of Sec. III-B with its sensor) and those that test it on
+**variants** (:attr:`Statement.variants`: the footprint sensors, costs outside a
+proposition's premise). The two are judged apart, by the same rule, and the statement's
+verdict is the one on the paper's setups; the verdict on variants is shown beside it, never
+folded in ("not shown on the paper's setups; shown on the variants").
 
-* A general statement is judged on its evidence **on the paper's own setups** (claims with
-  ``part == "paper"``): the common verdict when they agree, ``mixed`` when they disagree
-  (the breakdown is printed with it). Evidence on variants is shown beside it, not counted.
-* A hedged statement ("may") is an existence claim: one setting where it happens suffices,
-  so it is judged on all its evidence, the paper's setups and the variants, and the verdict
-  names the settings where it was shown and where it was not.
+* A general statement (:data:`GENERAL_RULE`): the common verdict of its pieces, ``mixed``
+  when they disagree (the pieces are named with their verdicts).
+* A hedged statement ("may", :data:`HEDGED_RULE`) is an existence claim, so one piece that
+  shows it suffices, unless another piece on the same kind of setup shows it absent (``not
+  supported`` or ``equivalent``): then the evidence disagrees and the verdict is ``mixed``.
 """
 
 from __future__ import annotations
@@ -27,6 +27,7 @@ from rsmhp.report.verdicts import Case, Facts, Rule
 __all__ = [
     "GENERAL_RULE",
     "HEDGED_RULE",
+    "NOT_TESTED",
     "STATEMENTS",
     "Judgement",
     "Statement",
@@ -35,13 +36,17 @@ __all__ = [
     "judge_all",
 ]
 
+#: the verdict of a kind of setup without evidence
+NOT_TESTED = "not tested"
+
 
 @dataclass(frozen=True)
 class Statement:
     """A statement of the paper: ``id``, where the paper makes it (``where``), what it says
-    in our words (``says``), whether it is hedged ("may"), the ids of the claims that are its
-    evidence (an id ending in ``*`` matches every claim id with that prefix, e.g. one claim
-    per model variant), and a ``note`` printed with it (e.g. a gap in the paper's proof)."""
+    in our words (``says``), whether it is hedged ("may"), the ids of the claims that test it
+    on the paper's own setups (``evidence``) and on variants (``variants``) (an id ending in
+    ``*`` matches every claim id with that prefix, e.g. one claim per model variant), and a
+    ``note`` printed with it (e.g. a gap in the paper's proof)."""
 
     id: str
     where: str
@@ -49,21 +54,29 @@ class Statement:
     evidence: tuple[str, ...]
     hedged: bool = False
     note: str = ""
+    variants: tuple[str, ...] = ()
 
-    def matches(self, claim_id: str) -> bool:
+    @staticmethod
+    def _match(patterns: Iterable[str], claim_id: str) -> bool:
         return any(
-            claim_id.startswith(e[:-1]) if e.endswith("*") else claim_id == e for e in self.evidence
+            claim_id.startswith(e[:-1]) if e.endswith("*") else claim_id == e for e in patterns
         )
 
+    def matches(self, claim_id: str) -> bool:
+        """Whether the claim is evidence of this statement (on any setup)."""
+        return self._match(self.evidence, claim_id) or self._match(self.variants, claim_id)
 
-def _count(verdict: str):
-    return lambda f: f[verdict]
+    def on_variant(self, claim_id: str) -> bool:
+        """Whether the claim tests this statement on a variant (not the paper's setup)."""
+        return self._match(self.variants, claim_id) and not self._match(self.evidence, claim_id)
 
+
+_ABSENT = ("not supported", "equivalent")
 
 GENERAL_RULE = Rule(
-    basis="over its evidence on the paper's own setups",
+    basis="over its pieces of evidence on one kind of setup (the paper's, or the variants)",
     cases=(
-        Case("inconclusive", "there is none", lambda f: f["n"] == 0),
+        Case(NOT_TESTED, "there is none", lambda f: f["n"] == 0),
         *(
             Case(v, f"every piece is {v}", lambda f, v=v: f[v] == f["n"])
             for v in ("supported", "not supported", "equivalent", "inconclusive")
@@ -73,14 +86,25 @@ GENERAL_RULE = Rule(
 )
 
 HEDGED_RULE = Rule(
-    basis="the paper says 'may', so one setting where it happens suffices: over its evidence "
-    "on every setup (the paper's and the variants)",
+    basis="the paper says 'may', so one setting where it happens suffices unless another shows "
+    "it absent; over its pieces of evidence on one kind of setup",
     cases=(
-        Case("supported", "some piece is supported", lambda f: f["supported"] >= 1),
+        Case(NOT_TESTED, "there is none", lambda f: f["n"] == 0),
+        Case(
+            "supported",
+            "some piece is supported and none is not supported or equivalent",
+            lambda f: f["supported"] >= 1 and f["not supported"] + f["equivalent"] == 0,
+        ),
+        Case(
+            "mixed",
+            "some piece is supported and some is not supported or equivalent (shown and shown "
+            "absent)",
+            lambda f: f["supported"] >= 1,
+        ),
         Case(
             "not supported",
-            "every piece is not supported or equivalent (shown absent everywhere it was tested)",
-            lambda f: f["n"] > 0 and f["not supported"] + f["equivalent"] == f["n"],
+            "every piece is not supported or equivalent (shown absent wherever tested)",
+            lambda f: f["not supported"] + f["equivalent"] == f["n"],
         ),
     ),
     otherwise="inconclusive",
@@ -93,11 +117,17 @@ def evidence_facts(claims: Iterable[Claim]) -> Facts:
     return {"n": len(claims), **{v: sum(c.verdict == v for c in claims) for v in VERDICTS}}
 
 
+def _pieces(claims: Sequence[Claim]) -> str:
+    return ", ".join(f"{c.id} {c.verdict}" for c in claims)
+
+
 @dataclass(frozen=True)
 class Judgement:
-    """A statement with its evidence (``counted``: the claims the verdict rests on;
-    ``alongside``: variant evidence shown but not counted), its verdict, the rule's text and
-    ``scope``, the settings in words (where it was shown, where not)."""
+    """A statement judged where the paper made it: its evidence on the paper's setups
+    (``counted``; the statement's ``verdict`` rests on it) and on variants (``alongside``,
+    judged apart: ``on_variants``, or ``None`` without any), each kind's verdict by the
+    statement's rule (:data:`NOT_TESTED` without evidence), the rule's text, and ``scope``:
+    the verdicts in words ("not shown on the paper's setups (…); shown on the variants (…)")."""
 
     statement: Statement
     counted: tuple[Claim, ...]
@@ -105,44 +135,54 @@ class Judgement:
     verdict: str
     rule: str
     scope: str
+    on_variants: str | None = None
+
+    @property
+    def disagreeing(self) -> str:
+        """For a ``mixed`` verdict, the pieces by verdict ("supported: EST-4; not supported:
+        DEC-4; equivalent: UAV-3"); empty otherwise."""
+        if self.verdict != "mixed":
+            return ""
+        by = {v: [c.id for c in self.counted if c.verdict == v] for v in VERDICTS}
+        return "; ".join(f"{v}: {', '.join(ids)}" for v, ids in by.items() if ids)
 
 
-def _settings(claims: Sequence[Claim]) -> str:
-    return "; ".join(f"{c.setup} ({c.id}: {c.verdict})" for c in claims)
+_SHOWN = {
+    "supported": "shown",
+    "not supported": "contradicted",
+    "equivalent": "absent (equivalent)",
+    "inconclusive": "not shown (inconclusive)",
+    "mixed": "mixed",
+    NOT_TESTED: "not tested",
+}
 
 
-def _scope(statement: Statement, counted: Sequence[Claim]) -> str:
-    if not statement.hedged:
-        return _settings(counted)
-    shown = [c for c in counted if c.verdict == "supported"]
-    other = [c for c in counted if c.verdict != "supported"]
-    parts = []
-    if shown:
-        parts.append("shown on: " + _settings(shown))
-    if other:
-        parts.append("not shown on: " + _settings(other))
-    return "; ".join(parts)
+def _scope(on_paper: str, paper: Sequence[Claim], on_var: str | None, var: Sequence[Claim]) -> str:
+    out = f"{_SHOWN[on_paper]} on the paper's setups" + (f" ({_pieces(paper)})" if paper else "")
+    if on_var is not None:
+        out += f"; {_SHOWN[on_var]} on the variants ({_pieces(var)})"
+    return out
 
 
 def judge(statement: Statement, claims: Iterable[Claim]) -> Judgement | None:
-    """The statement's verdict from the claims of this run that are its evidence (``None``
+    """The statement's verdicts from the claims of this run that are its evidence (``None``
     if none of them was run)."""
     evidence = [c for c in claims if statement.matches(c.id)]
     if not evidence:
         return None
-    if statement.hedged:
-        counted, alongside, rule = evidence, [], HEDGED_RULE
-    else:
-        counted = [c for c in evidence if c.part == "paper"]
-        alongside = [c for c in evidence if c.part != "paper"]
-        rule = GENERAL_RULE
+    rule = HEDGED_RULE if statement.hedged else GENERAL_RULE
+    paper = [c for c in evidence if not statement.on_variant(c.id)]
+    var = [c for c in evidence if statement.on_variant(c.id)]
+    on_paper = rule.verdict(evidence_facts(paper))
+    on_var = rule.verdict(evidence_facts(var)) if var else None
     return Judgement(
         statement=statement,
-        counted=tuple(counted),
-        alongside=tuple(alongside),
-        verdict=rule.verdict(evidence_facts(counted)),
+        counted=tuple(paper),
+        alongside=tuple(var),
+        verdict=on_paper,
         rule=rule.text(),
-        scope=_scope(statement, counted),
+        scope=_scope(on_paper, paper, on_var, var),
+        on_variants=on_var,
     )
 
 
@@ -196,8 +236,9 @@ STATEMENTS: tuple[Statement, ...] = (
         "Sec. II",
         "NBO completely ignores the uncertainty of the state evolution and may generate "
         "severely sub-optimal controls",
-        ("DEC-1", "DEC-6", "DEC-7-*", "DEC-8a", "DEC-8b"),
+        ("DEC-1", "DEC-6", "DEC-8b"),
         hedged=True,
+        variants=("DEC-7-*", "DEC-8a"),
         note="In the oven LQG with open-loop controls, J(u) − J_NBO(u) = r v_H does not "
         "depend on u, so NBO's minimiser is the exact optimum before any simulation runs "
         "(certainty equivalence): DEC-1 confirms the derivation numerically, it cannot come "
@@ -224,7 +265,8 @@ STATEMENTS: tuple[Statement, ...] = (
         "for linear dynamics and a linear cost, P(|J_n − J| ≥ ε) ≤ Var(p)/(n ε²) for the "
         "average J_n of n independent trajectories, with Var(p) = C[Σ_k 𝒜_k Σ 𝒜_kᵀ]Cᵀ "
         "(𝒜_k = Σ_{q<H−k} A^q, C the cost's row vector)",
-        ("LIN-1", "LQG-3", "EST-3"),
+        ("LIN-1",),
+        variants=("LQG-3", "EST-3"),
     ),
     Statement(
         "S5",
@@ -264,6 +306,7 @@ STATEMENTS: tuple[Statement, ...] = (
         "S9",
         "Sec. III-B, Fig. 5",
         "RS-MHP tracks the target with a lower average location error than NBO",
-        ("UAV-2", "DEC-8a", "DEC-8b"),
+        ("UAV-2", "DEC-8b"),
+        variants=("DEC-8a",),
     ),
 )

@@ -1,0 +1,261 @@
+"""The one-page answer: the claims the main text shows, how a verdict reads, and the values of
+"What we found".
+
+:data:`MAIN_CLAIMS` names, before any run, the at most ten claims of the main text: the
+paper's statements tested on several setups and the benchmark's own comparisons, one row
+each with its setups side by side (the ids are fixed here, so the judging data cannot choose
+them). Every other claim stays in the appendix ledger; the checks of our own machinery
+(``Claim.check``) have an appendix part and a count of their own.
+
+:func:`verdict_text` says what a verdict means (an equivalence whose CI excludes the null:
+"difference significant but below Δ"). :func:`found_values` computes the preformatted values
+of the "What we found" sentences (``findings.md``, rendered by :mod:`rsmhp.report.render`);
+every sentence names the claims it rests on and links them.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any
+
+import pandas as pd
+
+from rsmhp.report.ledger import STATEMENT_VERDICTS, Claim
+from rsmhp.report.markdown import fmt, fmt_ci, param_text
+from rsmhp.report.power import runs_needed
+from rsmhp.report.statements import Judgement
+
+__all__ = [
+    "MAIN_CLAIMS",
+    "MAX_MAIN",
+    "MainClaim",
+    "anchor",
+    "best_sentence",
+    "found_values",
+    "key_text",
+    "link",
+    "main_rows",
+    "verdict_text",
+]
+
+#: the most claims the main text shows
+MAX_MAIN = 10
+
+
+@dataclass(frozen=True)
+class MainClaim:
+    """A main-text row: ``name`` (short), what it claims in words (``says``), the paper
+    statement it tests (``statement``, empty for the benchmark's own), and its setups side by
+    side: (label, claim id) pairs."""
+
+    name: str
+    says: str
+    setups: tuple[tuple[str, str], ...]
+    statement: str = ""
+
+
+MAIN_CLAIMS: tuple[MainClaim, ...] = (
+    MainClaim(
+        "NBO's plans",
+        "NBO, which ignores the noise, chooses worse controls than sampling (regret)",
+        (("oven LQG", "DEC-1"), ("UAV paper", "DEC-6"), ("UAV footprint150", "DEC-7-footprint150")),
+        "S1",
+    ),
+    MainClaim(
+        "RS-MHP vs NBO",
+        "RS-MHP tracks the target with a lower closed-loop error than NBO",
+        (("UAV paper", "UAV-2"), ("map, no footprint", "DEC-8b"), ("map, footprint", "DEC-8a")),
+        "S9",
+    ),
+    MainClaim(
+        "Weighting",
+        "the likeliness-weighted average converges to the expected cost J",
+        (("oven LQG", "LQG-4"), ("estimator problems", "EST-2")),
+        "S3",
+    ),
+    MainClaim(
+        "Pruning",
+        "keeping the M most likely trajectories degrades the approximation or the decisions",
+        (("estimator problems", "EST-4"), ("oven LQG decisions", "DEC-4"), ("UAV paper", "UAV-3")),
+        "S5",
+    ),
+    MainClaim(
+        "RQMC at 1 ms",
+        "at 1 ms of planning per step, tuned RQMC tracks better than tuned RS-MHP",
+        (("UAV paper", "FR-1-paper"), ("UAV footprint150", "FR-1-footprint150")),
+    ),
+    MainClaim(
+        "Sigma points at 1 ms",
+        "at 1 ms per step, tuned sigma points track no worse than RS-MHP (by 0.25 m)",
+        (("UAV paper", "FR-2-paper"), ("UAV footprint150", "FR-2-footprint150")),
+    ),
+    MainClaim(
+        "Tree search at 1 ms",
+        "at 1 ms per step, the tuned tree search (PFT-DPW) tracks better than tuned RS-MHP",
+        (("UAV paper", "FR-3-paper"), ("UAV footprint150", "FR-3-footprint150")),
+    ),
+    MainClaim(
+        "NBO's error vs H",
+        "NBO's cost-approximation error grows with the horizon (H = 2 to 24)",
+        (("UAV paper", "HZ-1-paper"), ("UAV footprint150", "HZ-1-footprint150")),
+    ),
+    MainClaim(
+        "Pruning vs H",
+        "the pruned tree's cost error grows with H faster than Monte Carlo's",
+        (
+            ("oven LQG", "HZ-4"),
+            ("UAV paper", "HZ-2-paper"),
+            ("UAV footprint150", "HZ-2-footprint150"),
+        ),
+    ),
+    MainClaim(
+        "Sampling's gain vs H",
+        "RS-MHP's closed-loop advantage over NBO grows with the horizon",
+        (("UAV footprint150", "HZ-3-footprint150"),),
+    ),
+)
+
+
+def anchor(claim_id: str) -> str:
+    """The appendix anchor of a claim's details (its heading is ``### <id>``)."""
+    return re.sub(r"[^a-z0-9 -]", "", claim_id.lower()).replace(" ", "-")
+
+
+def link(claim_id: str, appendix: str = "appendix.md") -> str:
+    """``[id](appendix.md#id)``."""
+    return f"[{claim_id}]({appendix}#{anchor(claim_id)})"
+
+
+def key_text(c: Claim) -> str:
+    """The key number with its CI and unit: ``-0.050 [-0.20, +0.11] m``."""
+    k = c.key
+    signed = k.null == 0.0
+    out = fmt(k.value, k.digits, signed)
+    if k.has_ci:
+        out += " " + fmt_ci(k.ci_low, k.ci_high, k.digits, signed)
+    return out + (f" {k.unit}" if k.unit else "")
+
+
+def verdict_text(c: Claim) -> str:
+    """The verdict as it reads: ``equivalent (difference significant but below Δ = 0.25 m)``
+    when the CI of an equivalent key number excludes its null, else the verdict."""
+    k = c.key
+    if c.verdict == "equivalent" and k.has_ci and k.null is not None:
+        if not k.ci_low <= k.null <= k.ci_high:
+            delta = f"Δ = {fmt(k.margin, 3)}{' ' + k.unit if k.unit else ''}" if k.margin else "Δ"
+            return f"equivalent (difference significant but below {delta})"
+    return c.verdict
+
+
+def _power_text(c: Claim) -> str:
+    k = c.key
+    if k.n is None:
+        return ""
+    need = runs_needed(k)
+    if need is None:
+        return f"; n = {k.n}, no n decides it at this estimate"
+    return f"; n = {k.n}, {need} for 80% power"
+
+
+def main_rows(claims: Sequence[Claim], appendix: str = "appendix.md") -> list[dict[str, str]]:
+    """One dict per :data:`MAIN_CLAIMS` row with at least one claim in this run: ``name``,
+    ``says``, ``statement``, ``setups`` (the setups side by side: label, linked id, key
+    number, verdict and the runs at 80% power)."""
+    by_id = {c.id: c for c in claims}
+    rows = []
+    for m in MAIN_CLAIMS:
+        cells = []
+        for label, cid in m.setups:
+            c = by_id.get(cid)
+            if c is None:
+                continue
+            cells.append(
+                f"**{label}** {link(cid, appendix)}: {key_text(c)} → **{verdict_text(c)}**"
+                f"{_power_text(c)}"
+            )
+        if cells:
+            rows.append({"name": m.name, "says": m.says, "statement": m.statement, "setups": cells})
+    return rows
+
+
+def _ids(js: Sequence[Judgement]) -> str:
+    return ", ".join(j.statement.id for j in js)
+
+
+def _claim_phrase(c: Claim, appendix: str) -> str:
+    return f"{link(c.id, appendix)} {key_text(c)}, {verdict_text(c)}"
+
+
+def best_sentence(best: pd.DataFrame | None) -> str:
+    """Which family is best where, from the summary table ``best`` (columns ``group``,
+    ``model``, ``value``, ``best``, ``clear``; rows in the figure's order): per group and
+    model the runs of equal best method over the axis, each with how many of its cells the
+    best is clear in. Empty without a table."""
+    if best is None or best.empty:
+        return ""
+    unit = {"budget": " ms", "horizon": "", "scenario": ""}
+    prefix = {"budget": "", "horizon": "H = ", "scenario": ""}
+    parts = []
+    for (group, model), g in best.groupby(["group", "model"], sort=False):
+        runs: list[list[Any]] = []
+        for _, r in g.iterrows():
+            value = r["value"]
+            value = param_text(value) if isinstance(value, int | float) else str(value)
+            if runs and runs[-1][0] == r["best"]:
+                runs[-1][1].append(value)
+                runs[-1][2] += bool(r["clear"])
+            else:
+                runs.append([r["best"], [value], int(bool(r["clear"]))])
+        segs = []
+        for name, vals, clear in runs:
+            span = vals[0] if len(vals) == 1 else f"{vals[0]} to {vals[-1]}"
+            segs.append(
+                f"{name} at {prefix.get(group, '')}{span}{unit.get(group, '')} "
+                f"(clear in {clear} of {len(vals)})"
+            )
+        parts.append(f"by {group} on '{model}': " + ", ".join(segs))
+    return "; ".join(parts)
+
+
+def found_values(
+    judgements: Sequence[Judgement],
+    claims: Sequence[Claim],
+    best: pd.DataFrame | None = None,
+    appendix: str = "appendix.md",
+) -> Mapping[str, Any]:
+    """The values the "What we found" template fills in: the statements by verdict on the
+    paper's setups and on variants, the claims each sentence names (linked, with key number
+    and verdict), the best-family summary and the checks' count."""
+    by_id = {c.id: c for c in claims}
+
+    def phrase(cid: str) -> str:
+        return _claim_phrase(by_id[cid], appendix) if cid in by_id else ""
+
+    tally = {v: js for v in STATEMENT_VERDICTS if (js := [j for j in judgements if j.verdict == v])}
+    variants = [j for j in judgements if j.on_variants is not None and j.on_variants != j.verdict]
+    checks = [c for c in claims if c.check]
+    fr = [m for m in MAIN_CLAIMS if m.setups[0][1].startswith("FR-")]
+    hz = [m for m in MAIN_CLAIMS if m.setups[0][1].startswith("HZ-")]
+
+    def row_phrase(m: MainClaim) -> str:
+        got = [(lab, by_id[cid]) for lab, cid in m.setups if cid in by_id]
+        if not got:
+            return ""
+        inner = "; ".join(f"{lab}: {_claim_phrase(c, appendix)}" for lab, c in got)
+        return f"{m.says} ({inner})"
+
+    return {
+        "n_statements": len(judgements),
+        "tally": [(v, len(js), _ids(js)) for v, js in tally.items()],
+        "variants": [(j.statement.id, j.verdict, j.on_variants) for j in variants],
+        "statement": {j.statement.id: j for j in judgements},
+        "claim": phrase,
+        "fr": [p for m in fr if (p := row_phrase(m))],
+        "hz": [p for m in hz if (p := row_phrase(m))],
+        "best": best_sentence(best),
+        "n_checks": len(checks),
+        "checks_supported": sum(c.verdict == "supported" for c in checks),
+        "has": lambda cid: cid in by_id,
+    }
