@@ -56,6 +56,10 @@ except ConfigError as exc:
 validate(config, "workflow/schemas/config.schema.yaml")
 
 
+# The HTML report (snakemake --report) opens on the findings and the summary figure.
+report: "workflow/report/workflow.rst"
+
+
 include: "workflow/rules/common.smk"
 include: "workflow/rules/lqg.smk"
 include: "workflow/rules/estimators.smk"

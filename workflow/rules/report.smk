@@ -21,6 +21,13 @@ rule report:
         appendix="results/paper/appendix.md",
         claims="results/paper/claims.json",
         glance="results/paper/glance.md",
+        # the HTML report's landing page (workflow/report/workflow.rst includes it)
+        summary=_in_report(
+            "results/paper/summary.html",
+            caption="../report/summary.rst",
+            category="1 Summary",
+            labels={"item": "What we found"},
+        ),
         figures=expand("results/paper/figures/{name}.png", name=REPORT_FIGURES),
         provenance="results/provenance.json",
     log:

@@ -12,9 +12,18 @@ from rsmhp.pipeline.io import write_text
 from rsmhp.pipeline.protocol import file_commit
 from rsmhp.pipeline.script import rule_logging
 from rsmhp.report.history import load_history
+from rsmhp.report.html import summary_fragment
 from rsmhp.report.ledger import Section, claims_records
 from rsmhp.report.provenance import code_provenance, provenance
-from rsmhp.report.render import glance_table, render_appendix, render_report, statements_records
+from rsmhp.report.render import (
+    SUMMARY_CAPTION,
+    SUMMARY_FIGURE,
+    glance_table,
+    render_appendix,
+    render_report,
+    statements_records,
+    what_we_found,
+)
 from rsmhp.report.statements import judge_all
 from rsmhp.report.verdicts import holm_sections
 
@@ -50,6 +59,17 @@ with rule_logging(snakemake) as log:
     best = pd.read_csv(snakemake.input.best[0]) if snakemake.input.best else None
     main = render_report(sections, summary, best=best, history=history)
     write_text(main, snakemake.output.report)
+    # the HTML report's landing page (workflow/report/workflow.rst): the same findings and figure
+    figure = next((f for f in snakemake.output.figures if Path(f).stem == SUMMARY_FIGURE), None)
+    write_text(
+        summary_fragment(
+            what_we_found(sections, best=best),
+            figure,
+            SUMMARY_CAPTION if figure else "",
+            title="rsmhp replication report",
+        ),
+        snakemake.output.summary,
+    )
     write_text(
         render_appendix(sections, snakemake.params.config, summary, history=history),
         snakemake.output.appendix,

@@ -27,6 +27,9 @@ from rsmhp.report.statements import GENERAL_RULE, HEDGED_RULE, Judgement, Statem
 from rsmhp.report.templates import render as render_template
 
 __all__ = [
+    "MAIN_POLICY",
+    "SUMMARY_CAPTION",
+    "SUMMARY_FIGURE",
     "SYMBOLS",
     "VERDICT_POLICY",
     "claims_table",
@@ -35,6 +38,7 @@ __all__ = [
     "render_report",
     "statements_records",
     "statements_table",
+    "what_we_found",
 ]
 
 
@@ -177,6 +181,15 @@ VERDICT_POLICY = (
     "the side opposite to a claim are named next to it (contrary evidence)."
 )
 
+#: the same principle, short, for the main text (the rules themselves are in the appendix)
+MAIN_POLICY = (
+    "Every verdict comes from a rule fixed before the run that judges it and printed with "
+    "the claim in the appendix (linked): **supported** only when the 95% CI of the key number "
+    "lies entirely on the claimed side, **not supported** when it lies on the opposite side "
+    "(or contradicts a closed form), **equivalent** when it lies inside a margin ±Δ fixed "
+    "before the run, **inconclusive** otherwise."
+)
+
 
 def _counts(verdicts: Iterable[str], vocabulary: tuple[str, ...]) -> str:
     verdicts = list(verdicts)
@@ -240,11 +253,10 @@ def _main_claims_part(
     return [
         f"## The main claims ({len(rows)})",
         "",
-        VERDICT_POLICY
+        MAIN_POLICY
         + " n is the number of paired runs (or belief states) behind a CI; 'for 80% power': "
         "the n at which the rule would decide with 80% probability if the true difference were "
-        "the estimate (normal approximation). Each claim's rule, all its numbers and what was "
-        f"left out are in the appendix (linked). {n_other} further claims are in the appendix "
+        f"the estimate (normal approximation). {n_other} further claims are in the appendix "
         f"ledger, and {n_checks} checks of our machinery in a part of their own.",
         "",
         *table,
@@ -271,6 +283,28 @@ def _studies_part(sections: Sequence[Section]) -> list[str]:
     return [*lines, ""]
 
 
+#: the caption of the summary figure (main text and the HTML report's landing page)
+SUMMARY_CAPTION = (
+    "The family with the lowest closed-loop error per cell (solid: better than every other "
+    "family, paired 95% CI; hatched: tied, with the number of families tied)."
+)
+
+
+def what_we_found(
+    sections: Iterable[Section],
+    statements: Sequence[Statement] | None = None,
+    best: pd.DataFrame | None = None,
+    appendix: str = "appendix.md",
+) -> str:
+    """The "What we found" sentences (numbered Markdown) of the main text, from the claims
+    of ``sections``, their statements' judgements and the best-family table ``best``."""
+    sections = sorted(sections, key=lambda s: (s.order, s.key))
+    claims = [c for s in sections for c in s.claims]
+    judgements, _ = judge_all(claims, statements)
+    values = found_values(judgements, claims, best, appendix)
+    return render_template("rsmhp.report", "findings.md", **values).strip()
+
+
 def render_report(
     sections: Iterable[Section],
     provenance: Mapping[str, str],
@@ -288,16 +322,13 @@ def render_report(
     sections = sorted(sections, key=lambda s: (s.order, s.key))
     claims = [c for s in sections for c in s.claims]
     judgements, untested = judge_all(claims, statements)
-    found = render_template(
-        "rsmhp.report", "findings.md", **found_values(judgements, claims, best, appendix)
-    ).strip()
+    found = what_we_found(sections, statements, best, appendix)
     figure = []
     if any(SUMMARY_FIGURE in s.figures for s in sections):
         figure = [
             f"![Best family per scenario, budget and horizon](figures/{SUMMARY_FIGURE}.png)",
             "",
-            "*The family with the lowest closed-loop error per cell (solid: better than every "
-            "other family, paired 95% CI; hatched: tied, with the number of families tied).*",
+            f"*{SUMMARY_CAPTION}*",
             "",
         ]
     n_bit = sum(c.key.reproducible == "bitwise" for c in claims)
