@@ -906,3 +906,22 @@ def test_weighted_mc_regret_matches_the_first_order_closed_form():
     )
     # the regret's spread is not exactly chi2_1 here; its sample SD gives the standard error
     assert abs(reg.mean() - mean) < 4 * reg.std(ddof=1) / np.sqrt(R)
+
+
+def test_checks_are_the_closed_form_claims():
+    """DEC-2, DEC-3 and DEC-5 test the simulated regret against closed forms (checks of our
+    own machinery, counted apart from the findings); DEC-1 and DEC-4 are findings. No key
+    number is a paired mean judged against a margin: ``n`` and ``margin`` stay unset."""
+    summary = dec.summarize_lqg_regret(_synthetic(nbo_regret=1.0, pruned_slope=-1.0), MODEL)
+    weighted = _summary(
+        [
+            {"a": 0.5, "H": 2, "method": "mc", "weighting": "likeliness", "P": p,
+             "closed_form": 1.0 / p, "closed_kind": "asymptotic", "z": 0.5}
+            for p in (100, 1000)
+        ]
+    )  # fmt: skip
+    summary = pd.concat([summary, weighted], ignore_index=True)
+    claims = dec_claims.lqg_claims(summary, dec.lqg_scaling(summary), MODEL)
+    assert [c.id for c in claims] == ["DEC-1", "DEC-2", "DEC-3", "DEC-4", "DEC-5"]
+    assert {c.id for c in claims if c.check} == {"DEC-2", "DEC-3", "DEC-5"}
+    assert all(c.key.n is None and c.key.margin is None for c in claims)

@@ -481,6 +481,46 @@ def test_the_margin_comes_from_the_config():
         _regret_claims(spec, {**CLAIM_RULES, "equivalence_margin_pp": 0})
 
 
+@pytest.mark.parametrize("margin", [0.1, 0.3])
+def test_regret_key_numbers_carry_their_belief_states_and_the_rules_margin(margin):
+    """DEC-6/DEC-7: ``n`` is the number of belief states scored for both NBO and RS-MHP (the
+    pairs the bootstrap resamples), counted in the input; ``margin`` the rule's ±m."""
+    spec = {"paper": (0.03, 0.01, 0.0005), "fp": (0.01, 0.01, 0.002)}
+    df = _regret_rows(spec, n_runs=7)
+    summary = dec.summarize_uav_regret(df, 1, 500)
+    empty = pd.DataFrame(columns=dec.MAP_GROUP_COLUMNS)
+    rules = {**CLAIM_RULES, "equivalence_margin_pp": margin}
+    claims = {c.id: c for c in dec_claims.uav_claims(df, summary, pd.DataFrame(), empty, rules,
+                                                     1, 500)}  # fmt: skip
+    assert set(claims) == {"DEC-6", "DEC-7-fp"}
+    for cid, model in (("DEC-6", "paper"), ("DEC-7-fp", "fp")):
+        g = df[df["model"] == model].groupby(["run", "step"])["method"].apply(set)
+        states = int(sum({"nbo", "rsmhp_nt100"} <= m for m in g))
+        c = claims[cid]
+        assert states == 14 and c.key.n == states and f"{states} belief states" in c.measured
+        assert c.key.margin == margin and f"±{margin:g} pp" in c.rule
+        assert c.key.null == 0.0 and not c.check
+
+
+def test_map_key_numbers_carry_the_runs_paired_in_every_cell():
+    """DEC-8a/b: the CI resamples runs (each run's difference averaged over the group's
+    cells), so ``n`` is the number of runs paired in every cell of the group, counted in the
+    input; DEC8_RULE has no margin."""
+    runs = _map_runs(-2.0)
+    drop = (
+        (runs["cell"] == "r1c0") & (runs["method"] == "rsmhp_nt100") & runs["run"].isin([3, 11])
+    ) | ((runs["cell"] == "r0c0") & (runs["method"] == "nbo") & (runs["run"] == 5))
+    runs = runs[~drop]
+    _, _, claims = _map_claims(runs)
+    for cid, cell in (("DEC-8a", "r1c0"), ("DEC-8b", "r0c0")):
+        g = runs[runs["cell"] == cell].groupby("run")["method"].nunique()
+        paired = int((g == 2).sum())
+        c = claims[cid]
+        assert c.key.n == paired and not c.check and c.key.margin is None
+        assert f"{paired} paired runs per cell" in c.measured
+    assert (claims["DEC-8a"].key.n, claims["DEC-8b"].key.n) == (38, 39)
+
+
 NAN_INF = re.compile(r"\b(nan|inf)\b", re.IGNORECASE)
 WHOLE_FLOAT_CELL = re.compile(r"\|\s*[+-]?\d+\.0\s*\|")
 SECTION_CFG = {

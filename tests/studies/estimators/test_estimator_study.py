@@ -225,6 +225,14 @@ def test_verdicts_follow_the_data(summary, cheb):
     assert est_claims.claim_est1(bad).verdict == "not supported"
 
 
+def test_only_est3_is_a_check(summary, cheb):
+    """EST-3 tests plain Monte Carlo against the exact tail probability (a check of our own
+    estimator, counted apart from the findings); no key number is a paired mean with ``n``."""
+    claims = est_claims.claims(summary, cheb)
+    assert [c.id for c in claims if c.check] == ["EST-3"]
+    assert all(c.key.n is None and c.key.margin is None for c in claims)
+
+
 @pytest.fixture(scope="module")
 def mc_study(problems):
     """Plain MC only, at three budgets (a Var-vs-n slope per problem), 200 replicates."""

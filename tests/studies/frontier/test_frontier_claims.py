@@ -327,3 +327,61 @@ def test_recording_setup_shows_nbo_and_every_budget_member():
     assert setup.sensor.limited
     with pytest.raises(ValueError, match=re.escape("frontier.recording.model: 'nowhere'")):
         recording_setup(CONFIG["uav"], dec["uav"]["models"], fr, "nowhere")
+
+
+# ------------------------------------------------------- ledger fields: n, margin, check
+
+
+def _paired_runs(table: pd.DataFrame, a: str, b: str, col: str = "method") -> int:
+    """Runs of ``table`` with a row of both ``a`` and ``b``, counted by hand (the clusters of
+    a cluster-t CI: every belief state of a run belongs to it)."""
+    have = table.groupby(col)["run"].apply(set)
+    return len(have[a] & have[b])
+
+
+@pytest.mark.parametrize(("margin_pp", "margin_m"), [(0.1, 0.25), (0.2, 0.4)])
+def test_exploratory_key_numbers_carry_their_runs_and_the_rules_margin(margin_pp, margin_m):
+    """n: the runs the cluster-t CI rests on, counted in the input (for the regret, whose
+    belief states cluster in runs, the runs with a state of both members); margin: the
+    equivalence margin of FR-1's and FR-3's ci_side rule, None for FR-2's non-inferiority rule
+    (its margin is the null). Some rows are dropped from the tables the claims pair (the
+    summary, which only names the members run and their times, is that of the full tables)."""
+    runs, regret = _tables()
+    summary = summarize_frontier(runs, regret)
+    runs = runs[~((runs["method"] == "dpw_s30") & runs["run"].isin([1, 5]))]
+    regret = regret[~((regret["method"] == "rqmc_nt16") & (regret["run"] == 3))]
+    regret = regret[~((regret["method"] == "sigma") & (regret["run"] == 8) & (regret["step"] == 0))]
+    cfg = _cfg(margin_pp=margin_pp, margin_m=margin_m)
+    claims = {c.id: c for c in frontier_claims(runs, regret, summary, cfg, seed=11)}
+    fr1, fr2, fr3 = claims["FR-1-m"].key, claims["FR-2-m"].key, claims["FR-3-m"].key
+    assert fr1.n == _paired_runs(regret, "rqmc_nt16", "rsmhp_nt16") == N_STATES // 2 - 1
+    assert fr2.n == _paired_runs(regret, "sigma", "rsmhp_nt16") == N_STATES // 2  # run 8: 1 state
+    assert fr3.n == _paired_runs(runs, "dpw_s30", "rsmhp_nt16") == N_RUNS - 2
+    assert fr1.margin == margin_pp and f"±{margin_pp:g} pp" in claims["FR-1-m"].rule
+    assert fr2.margin is None and fr2.null == margin_pp
+    assert fr3.margin == margin_m and f"±{margin_m:g} m" in claims["FR-3-m"].rule
+    assert not any(c.check for c in claims.values())
+
+
+def test_confirmatory_key_numbers_carry_their_runs_and_the_rules_margin():
+    """The preregistered FR claims: n = runs paired (one value per run, t interval over them),
+    margin = the preregistered margin_m of a superiority rule, None for non-inferiority."""
+    from rsmhp.studies.frontier.claims import confirm_claims
+    from rsmhp.studies.frontier.summarise import ladder, summarize_configs
+    from tests.pipeline.test_protocol import PREREG, _confirm_tables
+
+    runs, timing, chosen = _confirm_tables()
+    s = summarize_configs(runs, timing)
+    lad = ladder(runs, s, chosen, [0.5, 2.0])
+    claims = {c.id: c for c in confirm_claims(runs, s, lad, PREREG, chosen, "f" * 64)}
+    ref = chosen["m"]["2"]["rsmhp"].name
+    for cid, family in (("FR-1-m", "rqmc"), ("FR-2-m", "sigma"), ("FR-3-m", "dpw")):
+        spec = PREREG["claims"][cid[:4]]
+        c = claims[cid]
+        n = _paired_runs(runs, chosen["m"]["2"][family].name, ref, col="config")
+        assert c.key.n == n and f"{n} paired runs" in c.measured and not c.check
+        if spec["test"] == "superiority":
+            assert c.key.margin == spec["margin_m"] and c.key.null == 0.0
+        else:
+            assert c.key.margin is None and c.key.null == spec["margin_m"]
+    assert {c.key.n for c in claims.values()} == {runs["run"].nunique()}

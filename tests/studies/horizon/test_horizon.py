@@ -426,3 +426,55 @@ def test_the_p_value_behind_each_verdict():
     assert _verdict_p("not supported", -est, se, df, "above") == pytest.approx(two_sided)
     assert _verdict_p("inconclusive", est, se, df, "above") == pytest.approx(two_sided)
     assert _verdict_p("inconclusive", est, se, df, "below") == 1.0
+
+
+def test_key_numbers_carry_the_runs_their_cis_rest_on():
+    """HZ-1/HZ-2: the cluster-t CI's clusters are runs, so ``n`` is the number of runs with a
+    belief state shared by every member and horizon the growth compares; HZ-3: the runs
+    paired at both horizons. Counted in the input, some rows dropped; no margin (the rules
+    have none) and no claim is a check of our own machinery."""
+    from rsmhp.studies.horizon.claims import horizon_claims
+
+    rng = np.random.default_rng(6)
+    methods = ("nbo", "tree_n4_m256", "rsmhp_nt256")
+    lo = {m: rng.normal(0, 0.01, (24, 3)) for m in methods}
+    hi = {m: rng.normal(0.01, 0.02, (24, 3)) for m in methods}
+    # 24 belief states: 2 steps of 12 runs
+    df = pd.concat([_table(lo, H=4, steps=2), _table(hi, H=24, steps=2)], ignore_index=True)
+    df["family"] = df["method"].map({"nbo": "nbo", "tree_n4_m256": "tree", "rsmhp_nt256": "rsmhp"})
+    gone = ((df["method"] == "nbo") & (df["H"] == 24) & (df["run"] == 3)) | (
+        (df["method"] == "tree_n4_m256") & (df["H"] == 4) & df["run"].isin([0, 7])
+    )
+    gone |= (df["method"] == "rsmhp_nt256") & (df["run"] == 9) & (df["step"] == 0)  # 1 state
+    df = df[~gone].reset_index(drop=True)
+    rows = []
+    for H in (2, 24):
+        for method in ("nbo", "rsmhp_nt256"):
+            e = 100.0 + rng.normal(0.0, 2.0, 15)
+            skip = (2, 4) if (method, H) == ("nbo", 24) else ()  # runs without a result
+            rows += [{"model": "m", "H": H, "method": method, "family": method[:5], "run": r,
+                      "mean_error": e[r], "final_error": 0.0, "plan_ms": 1.0}
+                     for r in range(15) if r not in skip]  # fmt: skip
+    closed = pd.DataFrame(rows)
+    cfg = {"bootstrap": 300, "claims": {"tree": "tree_n4_m256", "monte_carlo": "rsmhp_nt256",
+                                        "closed_model": "m"}}  # fmt: skip
+    summary = summarize_approx(df, seed=1, n_boot=200)
+    claims = {c.id: c for c in horizon_claims(df, summary, cfg, seed=2, closed=closed)}
+    assert set(claims) == {"HZ-1-m", "HZ-2-m", "HZ-3-m"}
+
+    def runs_with_all(pairs: list[tuple[str, int]]) -> int:
+        """Runs with a belief state that every (method, H) of ``pairs`` has."""
+        have = [set(zip(*[df.loc[(df["method"] == m) & (df["H"] == h), c] for c in ("run", "step")],
+                        strict=True)) for m, h in pairs]  # fmt: skip
+        return len({run for run, _ in set.intersection(*have)})
+
+    n1 = runs_with_all([("nbo", 4), ("nbo", 24)])
+    n2 = runs_with_all([(m, h) for m in methods[1:] for h in (4, 24)])
+    w = closed.pivot_table(index="run", columns=["H", "method"], values="mean_error")
+    n3 = int(w.notna().all(axis=1).sum())
+    assert (n1, n2, n3) == (11, 10, 13)
+    for cid, n in (("HZ-1-m", n1), ("HZ-2-m", n2), ("HZ-3-m", n3)):
+        c = claims[cid]
+        assert c.key.n == n and c.key.margin is None and not c.check
+    assert f"of {n1} runs" in claims["HZ-1-m"].measured
+    assert claims["HZ-3-m"].measured.startswith(f"{n3} paired runs")

@@ -255,3 +255,25 @@ def test_bad_lqg_horizon_config_is_refused_naming_the_field(edit, expected):
     edit(cfg["horizon"]["lqg"])
     with pytest.raises(ConfigError, match=re.escape(expected)):
         check_config(cfg)
+
+
+def test_hz4_carries_its_replicates_and_hz5_is_a_check():
+    """HZ-4's CI resamples each cell's independent replicates: ``n`` is the replicates per
+    cell, counted in the input (here 37, not the config's 40); its rule has no margin.
+    HZ-5 tests Monte Carlo's regret against its closed form: a check of our own machinery,
+    without ``n``."""
+    rng = np.random.default_rng(9)
+    cells = (("pruned", 2, 3), ("pruned", 2, 6), ("mc", 0, 3), ("mc", 0, 6))
+    est = _rows({cell: rng.normal(0, 0.3, 37) for cell in cells})
+    summary = pd.DataFrame(
+        [{"method": "mc", "weighting": "uniform", "closed_kind": "exact", "a": 0.5, "H": H,
+          "P": P, "z": 0.3, "closed_form": 1.0 / P, "limit": 1.1 / P}
+         for H in (2, 6) for P in (8, 32)]
+    )  # fmt: skip
+    claims = {c.id: c for c in lqg_horizon_claims(est, summary, CFG, 0.5, 5)}
+    assert set(claims) == {"HZ-4", "HZ-5"}
+    hz4, hz5 = claims["HZ-4"], claims["HZ-5"]
+    assert hz4.key.n == 37 == est.groupby(["scheme", "H"]).size().min()
+    assert hz4.measured.startswith("37 replicates per cell")
+    assert hz4.key.margin is None and not hz4.check
+    assert hz5.check and hz5.key.n is None and hz5.key.margin is None

@@ -738,3 +738,13 @@ def test_claims_print_the_rule_they_apply(small):
     again = claims.lqg_claims(small["summary"], small["nbo"], small["conv"], EPS, small["linear"])
     assert again == section.claims
     assert again[-1] == claims.linear_claim(small["linear"])
+
+
+def test_checks_are_the_closed_form_claims_and_no_key_number_has_n(small):
+    """LQG-1, LQG-3 and LIN-1 test the simulation against closed forms (checks of our own
+    machinery, counted apart from the findings); LQG-2 and LQG-4 are findings. No key number
+    here is a paired mean difference judged against a margin: ``n`` and ``margin`` stay
+    unset."""
+    section = small["section"]
+    assert {c.id for c in section.claims if c.check} == {"LQG-1", "LQG-3", "LIN-1"}
+    assert all(c.key.n is None and c.key.margin is None for c in section.claims)

@@ -222,6 +222,7 @@ def _dec2(scaling: pd.DataFrame, z: ZCheck) -> Claim | None:
         f"limit {fmt(z.limit, 3)})",
         part="beyond",
         setup=SETUP,
+        check=True,
     )
 
 
@@ -255,6 +256,7 @@ def _dec3(
         dropped="likeliness-weighted trees (no closed form; in the appendix table)",
         part="beyond",
         setup=SETUP,
+        check=True,
     )
 
 
@@ -370,6 +372,7 @@ def _dec5(summary: pd.DataFrame, z: ZCheck) -> Claim | None:
         ),
         part="beyond",
         setup=SETUP,
+        check=True,
     )
 
 

@@ -33,6 +33,7 @@ from rsmhp.report.markdown import fmt, fmt_ci, param_text, range_text
 from rsmhp.report.palette import method_label
 from rsmhp.report.verdicts import Case, Facts, Rule, ci_side
 from rsmhp.studies.decisions.summarise_uav import (
+    PairedRegret,
     axis_label,
     base_model,
     largest_rsmhp,
@@ -116,18 +117,26 @@ def map_facts(group: pd.Series) -> Facts:
     }
 
 
-def _regret_key(method: str, m: float, lo: float, hi: float) -> KeyNumber:
+def _units(n: int) -> int | None:
+    """The number of paired units (belief states, runs) a bootstrap CI of a mean rests on,
+    as :attr:`KeyNumber.n`; ``None`` below 2 (no CI of a mean)."""
+    return int(n) if int(n) >= 2 else None
+
+
+def _regret_key(method: str, d: PairedRegret, margin_pp: float) -> KeyNumber:
     """Key number of DEC-6/DEC-7: paired mean of NBO's − ``method``'s relative regret (pp)
-    with its bootstrap CI."""
+    with its bootstrap CI over the ``d.n`` paired belief states, and the rule's margin."""
     return KeyNumber(
         f"NBO − {method_label(method)} relative regret, paired mean",
-        pp(m),
-        pp(lo),
-        pp(hi),
+        pp(d.mean),
+        pp(d.low),
+        pp(d.high),
         unit="pp",
         reproducible="statistical",
         digits=2,
         null=0.0,
+        n=_units(d.n),
+        margin=margin_pp,
     )
 
 
@@ -151,8 +160,9 @@ def _dec6(
     if nbo.empty:
         return None
     r = nbo.iloc[0]
+    rule = regret_rule(margin_pp, "the reconstruction")  # first: it checks the margin
     d = paired_regret(regret, base, best_rs, seed, n_boot)
-    key = _regret_key(best_rs, d.mean, d.low, d.high)
+    key = _regret_key(best_rs, d, margin_pp)
     sp = r["spearman_random"]
     sp_txt = (
         f"; Spearman rank correlation of NBO's cost with the evaluation cost over random "
@@ -160,7 +170,6 @@ def _dec6(
         if np.isfinite(sp)
         else ""
     )
-    rule = regret_rule(margin_pp, "the reconstruction")
     return Claim(
         "DEC-6",
         f"On the UAV reconstruction, {method_label(best_rs)} chooses better plans than NBO "
@@ -189,12 +198,12 @@ def _dec7(
     seed: int,
     n_boot: int,
 ) -> Claim:
+    rule = regret_rule(margin_pp, "the model variant")  # first: it checks the margin
     d = paired_regret(regret, model, best_rs, seed, n_boot)
     in_model = summary[summary["model"] == model]
     s_nbo = in_model[in_model["method"] == baseline_name()].iloc[0]
     s_rs = in_model[in_model["method"] == best_rs].iloc[0]
-    key = _regret_key(best_rs, d.mean, d.low, d.high)
-    rule = regret_rule(margin_pp, "the model variant")
+    key = _regret_key(best_rs, d, margin_pp)
     return Claim(
         f"DEC-7-{model}",
         f"On the UAV variant '{model}', {method_label(best_rs)} chooses better plans than "
@@ -293,6 +302,7 @@ def _dec8_claim(
             reproducible="statistical",
             digits=3,
             null=0.0,
+            n=_units(g["n_runs"]),
         ),
         DEC8_RULE.verdict(map_facts(g)),
         DEC8_RULE.text(),

@@ -485,6 +485,7 @@ def claim_est3(s: pd.DataFrame, cheb: pd.DataFrame) -> Claim:
         measured=measured,
         part="beyond",
         setup=f"{SETUP}, quadratic costs (outside Prop. 3's linear premise)",
+        check=True,
     )
 
 

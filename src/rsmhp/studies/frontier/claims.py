@@ -105,7 +105,18 @@ def budget_member(members: Sequence[str], family: type[Method]) -> str | None:
     return hits[0] if hits else None
 
 
-def _key(name: str, d: Paired, unit: str, null: float, p_value: float) -> KeyNumber:
+def _runs(d: Paired) -> int | None:
+    """The runs the cluster-t CI of ``d`` rests on (its clusters: paired runs, also for the
+    regret, whose belief states cluster in runs), as :attr:`KeyNumber.n`; ``None`` below 2."""
+    return int(d.clusters) if d.clusters >= 2 else None
+
+
+def _key(
+    name: str, d: Paired, unit: str, null: float, p_value: float, margin: float | None
+) -> KeyNumber:
+    """The key number of an FR claim: ``d``'s mean and cluster-t CI over its runs, and the
+    equivalence ``margin`` of a :func:`~rsmhp.report.verdicts.ci_side` rule (``None`` for a
+    non-inferiority rule, whose margin is the ``null``)."""
     return KeyNumber(
         name,
         float(d.mean),
@@ -116,6 +127,8 @@ def _key(name: str, d: Paired, unit: str, null: float, p_value: float) -> KeyNum
         digits=3 if unit == "m" else 2,
         null=null,
         p_value=p_value,
+        n=_runs(d),
+        margin=margin,
     )
 
 
@@ -212,6 +225,7 @@ def _model_claims(
                     "pp",
                     0.0,
                     _p_side(d, verdict, margin_pp),
+                    margin_pp,
                 ),
                 verdict,
                 rule.text(),
@@ -241,6 +255,7 @@ def _model_claims(
                     "pp",
                     margin_pp,
                     _p_noninferior(d, verdict, margin_pp),
+                    None,
                 ),
                 verdict,
                 rule.text(),
@@ -275,6 +290,7 @@ def _model_claims(
                     "m",
                     0.0,
                     _p_side(e, verdict, margin_m),
+                    margin_m,
                 ),
                 verdict,
                 rule.text(),
@@ -456,6 +472,10 @@ def confirm_claims(
                         digits=3,
                         null=0.0 if spec["test"] == "superiority" else margin,
                         p_value=p,
+                        n=_runs(d),
+                        # a superiority rule's equivalence margin; a non-inferiority rule's
+                        # margin is the null
+                        margin=margin if spec["test"] == "superiority" else None,
                     ),
                     verdict,
                     rule.text() + f" (preregistered, sha256 {prereg_sha[:12]})",

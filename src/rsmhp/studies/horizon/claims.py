@@ -221,6 +221,7 @@ def _hz3_evidence(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: in
             digits=3,
             null=0.0,
             p_value=p,
+            n=_units(a.n),
         ),
         verdict,
         rule.text(),
@@ -238,7 +239,15 @@ def _hz3_evidence(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: in
     return Evidence(claim, p, a.df, a.boot_low, a.boot_high, boot_verdict)
 
 
+def _units(n: int) -> int | None:
+    """The independent units (runs, replicates) a CI rests on, as :attr:`KeyNumber.n`;
+    ``None`` below 2 (no CI of a mean)."""
+    return int(n) if int(n) >= 2 else None
+
+
 def _key(name: str, g: Growth, p_value: float) -> KeyNumber:
+    """The key number of HZ-1/HZ-2: ``g`` in pp with its cluster-t CI over ``g.runs`` runs
+    (the clusters: the belief states of a run are not independent)."""
     return KeyNumber(
         name,
         100 * g.mean,
@@ -249,6 +258,7 @@ def _key(name: str, g: Growth, p_value: float) -> KeyNumber:
         digits=2,
         null=0.0,
         p_value=p_value,
+        n=_units(g.runs),
     )
 
 
@@ -460,6 +470,9 @@ def lqg_horizon_claims(
                         reproducible="statistical",
                         digits=2,
                         null=0.0,
+                        # the bootstrap resamples each of the four cells' independent
+                        # replicates: n is the replicates per cell (the smallest cell)
+                        n=_units(g.replicates),
                     ),
                     rule.verdict({f"{KEY}_low": g.low, f"{KEY}_high": g.high}),
                     rule.text(),
@@ -503,6 +516,7 @@ def lqg_horizon_claims(
                 f"{', '.join(str(int(p)) for p in sorted(mc['P'].unique()))}",
                 part="beyond",
                 setup="oven LQG, sample-average argmin over P independent trajectories",
+                check=True,
             )
         )
     return out

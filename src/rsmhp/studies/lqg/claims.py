@@ -155,6 +155,7 @@ def nbo_error_claim(nbo: pd.DataFrame, conv: pd.DataFrame) -> Claim:
         rule=rule.text(),
         measured=_nbo_error_measured(check),
         setup=SETUP,
+        check=True,
     )
 
 
@@ -302,6 +303,7 @@ def chebyshev_claim(summary: pd.DataFrame, eps_values: Sequence[float]) -> Claim
         measured=_chebyshev_measured(check, eps_values),
         part="beyond",
         setup=f"{SETUP}, quadratic cost (outside Prop. 3's linear premise)",
+        check=True,
     )
 
 
@@ -428,6 +430,7 @@ def linear_claim(check: LinearCostCheck) -> Claim:
             else ""
         ),
         setup=f"linear-cost 2-D system (LinearCost.example, H = {check.H})",
+        check=True,
     )
 
 

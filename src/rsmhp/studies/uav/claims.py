@@ -57,6 +57,13 @@ def paired_rule(a: str, b: str, margin: float) -> Rule:
     )
 
 
+def _paired_units(row: pd.Series) -> int | None:
+    """The runs the CI of one paired comparison rests on (``n_runs``: runs with a result for
+    both methods, the pairs the bootstrap resamples); ``None`` below 2 (no CI of a mean)."""
+    n = int(row["n_runs"])
+    return n if n >= 2 else None
+
+
 def paired_facts(row: pd.Series) -> Facts:
     """The facts :func:`paired_rule` is evaluated on: the CI of one paired comparison."""
     return {f"{KEY}_low": float(row["ci_low"]), f"{KEY}_high": float(row["ci_high"])}
@@ -122,6 +129,7 @@ def _claim(
 ) -> Claim:
     """Claim ``cid`` whose key number is the mean difference of the paired ``row``."""
     a, b = short_name(row["method"]), short_name(row["baseline"])
+    rule = paired_rule(a, b, margin)  # first: it checks the margin
     key = KeyNumber(
         name=f"mean d, e({a}) − e({b})",
         value=float(row["mean_diff"]),
@@ -131,8 +139,9 @@ def _claim(
         reproducible="statistical",
         digits=2,
         null=0.0,
+        n=_paired_units(row),
+        margin=float(margin),
     )
-    rule = paired_rule(a, b, margin)
     return Claim(
         id=cid,
         claim=claim,
