@@ -2,12 +2,15 @@
 
 Each aggregation rule writes a :class:`rsmhp.report.ledger.Section` as JSON
 (``results/report/<key>.json``): its Markdown body (figures referenced as
-``figures/<name>.png``), appendix and claims. The ``report`` rule renders every section, in
-``order``, into ``results/paper/replication.md`` and ``appendix.md`` (``make publish`` copies
-both to the tracked ``paper/``). This module only renders: statistics, verdict rules and each
-study's prose live elsewhere (``rsmhp.analysis``, :mod:`rsmhp.report.verdicts`,
-``rsmhp.narrative``),
-provenance in :mod:`rsmhp.report.provenance`, the README block in :mod:`rsmhp.report.readme`.
+``figures/<name>.png``), appendix and claims. The ``report`` rule renders the main text
+(:func:`render_report`: "What we found" with the summary figure, the paper's statements judged
+on its setups and on variants, the main claims of :data:`rsmhp.report.findings.MAIN_CLAIMS`,
+their fragile verdicts, an index of the studies) and the appendix (:func:`render_appendix`:
+the whole ledger, every claim in detail, each study's section, parameters, provenance) into
+``results/paper/`` (``make publish`` copies them to the tracked ``paper/``). This module only
+renders: statistics, verdict rules and each study's prose live elsewhere
+(:mod:`rsmhp.core.stats`, :mod:`rsmhp.report.verdicts`, the studies' templates), the
+sentences of "What we found" in ``findings.md`` beside this package.
 """
 
 from __future__ import annotations
