@@ -632,7 +632,7 @@ def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, 
     captions = sorted((ROOT / "workflow/report").glob("*.rst"))
     figures = [p.stem for p in (run_j2 / "results/figures").glob("*.png")]
     tables = [p.stem for p in (run_j2 / "results/tables").glob("*.md")]
-    assert len(figures) == 25 and len(tables) == 30
+    assert len(figures) == 26 and len(tables) == 31
     assert {c.stem for c in captions} == set(figures) | {f"table_{t}" for t in tables}
     for name in figures:
         assert f"{name}.png" in html, name

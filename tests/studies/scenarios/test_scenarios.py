@@ -16,6 +16,7 @@ from scipy import stats as sps
 
 from rsmhp.core.stats import probability_of_improvement
 from rsmhp.report.markdown import fmt
+from rsmhp.studies.scenarios.best import BEST_RUN_COLUMNS, best_family
 from rsmhp.studies.scenarios.figures import improvement_figure
 from rsmhp.studies.scenarios.section import scenarios_section, scenarios_tables
 from rsmhp.studies.scenarios.summarise import (
@@ -155,8 +156,9 @@ def test_section_and_figure_read_the_summary():
     map_runs, closed = _tables(np.random.default_rng(4))
     runs = scenario_runs(map_runs, closed)
     s = improvement_summary(runs, n_boot=200, seed=0)
-    tables = scenarios_tables(s, per_scenario(runs))
-    sec = scenarios_section(s, tables)
+    empty = best_family(pd.DataFrame(columns=BEST_RUN_COLUMNS))
+    tables = scenarios_tables(s, per_scenario(runs), empty.cells, empty.paired)
+    sec = scenarios_section(s, tables, empty.cells)
     assert sec.key == "scenarios" and not sec.claims
     assert f"{MAP_GROUP} (2, 2 methods)" in sec.body
     assert f"{HORIZON_GROUP} (3, 2 methods)" in sec.body

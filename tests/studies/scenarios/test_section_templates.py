@@ -14,6 +14,7 @@ from jinja2 import meta
 
 from rsmhp.report.templates import render
 from rsmhp.studies.scenarios import section
+from rsmhp.studies.scenarios.best import best_family
 from rsmhp.studies.scenarios.summarise import (
     HORIZON_GROUP,
     MAP_GROUP,
@@ -21,6 +22,7 @@ from rsmhp.studies.scenarios.summarise import (
     per_scenario,
     scenario_runs,
 )
+from tests.studies.scenarios.test_best import _three_groups
 from tests.studies.scenarios.test_scenarios import _tables
 
 PACKAGE = "rsmhp.studies.scenarios"
@@ -32,7 +34,8 @@ SYNTAX = ("{{", "}}", "{%", "%}", "{#", "#}")
 def data():
     runs = scenario_runs(*_tables(np.random.default_rng(5)))
     s = improvement_summary(runs, n_boot=200, seed=0)
-    return s, section.scenarios_tables(s, per_scenario(runs))
+    best = best_family(_three_groups(np.random.default_rng(6)))
+    return s, section.scenarios_tables(s, per_scenario(runs), best.cells, best.paired), best.cells
 
 
 @pytest.fixture
@@ -66,8 +69,27 @@ def test_every_template_gets_exactly_the_values_it_uses(rendered):
 
 
 def test_the_prose_is_complete(data):
-    summary, tables = data
-    sec = section.scenarios_section(summary, tables)
+    summary, tables, best = data
+    sec = section.scenarios_section(summary, tables, best)
+    assert sec.body.startswith(
+        "Which method gives the lowest closed-loop mean location error, cell by cell (figure "
+    )
+    for name in section.GROUP_NAMES.values():  # one sentence part per group, in order
+        assert f"{name} (" in sec.body
+    assert "equal compute, per budget (2 cells of 4 runs): " in sec.body
+    assert "; long horizons, per H (4 cells of 6 runs): " in sec.body
+    # the figure is in the appendix (the report's main text opens with it), listed in figures
+    assert "scenarios_best.png" not in sec.body and "scenarios_improvement.png" in sec.body
+    assert sec.figures == ["scenarios_best", "scenarios_improvement"]
+    assert sec.appendix.startswith(
+        "![Best method per cell](figures/scenarios_best.png)\n\n*Per cell the method with the "
+    )
+    assert "*\n\nBest method per cell (figure scenarios_best): in every cell" in sec.appendix
+    assert f"\n\n{tables['scenarios_best']}\n\nA scenario is a map cell" in sec.appendix
+    # without best-method cells the section opens with the probability of beating NBO
+    sec = section.scenarios_section(summary, tables, best.iloc[:0])
+    assert sec.figures == ["scenarios_improvement"]
+    assert sec.appendix.startswith("Best method per cell (figure scenarios_best): in every cell")
     assert sec.body.startswith("P(a method's closed-loop run beats NBO's paired run), mean over")
     assert f"(appendix: every method): {MAP_GROUP} (2, 2 methods): highest " in sec.body
     assert f"; {HORIZON_GROUP} (3, 2 methods): highest " in sec.body
@@ -75,13 +97,12 @@ def test_the_prose_is_complete(data):
         sec.body
     )
     assert sec.body.endswith("bars: 95% stratified bootstrap.*")
-    assert sec.appendix.startswith("A scenario is a map cell (decision study, H = 6, its stream)")
     assert sec.appendix.endswith(tables["scenarios_per_scenario"])
     assert f"\n\n{tables['scenarios_improvement']}\n\nPer scenario:\n\n" in sec.appendix
     # a group with one method names it once; no data: one sentence
-    one = section.scenarios_section(summary.groupby("group").head(1), tables)
+    one = section.scenarios_section(summary.groupby("group").head(1), tables, best.iloc[:0])
     assert f"{MAP_GROUP} (2): " in one.body and "highest" not in one.body
-    empty = section.scenarios_section(summary.iloc[:0], tables)
+    empty = section.scenarios_section(summary.iloc[:0], tables, best.iloc[:0])
     assert empty.body.startswith("No scenario has paired closed-loop runs of a method and NBO.\n\n")
 
 
@@ -93,4 +114,4 @@ def test_a_missing_value_is_an_error(rendered):
                 render(PACKAGE, name, **rest)
     group = {"group": "g", "scenarios": 2, "methods": 2, "lowest": None}  # no "highest"
     with pytest.raises(jinja2.UndefinedError, match="highest"):
-        render(PACKAGE, "section.md", empty=False, groups=[group])
+        render(PACKAGE, "section.md", best=[], empty=False, groups=[group])

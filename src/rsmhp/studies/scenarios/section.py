@@ -1,7 +1,10 @@
-"""Report section of the summary across scenarios (:mod:`rsmhp.studies.scenarios.summarise`): one
-sentence per group in the main text, the per-method table and the per-scenario table in the
-appendix. Numbers come from the tables; nothing is a claim. The prose is in the templates
-``section.md`` (main text) and ``appendix.md`` beside this module."""
+"""Report section of the scenarios study: in the main text, first the best method per cell
+(:mod:`rsmhp.studies.scenarios.best`: one sentence per group), then the probability of beating
+NBO (:mod:`rsmhp.studies.scenarios.summarise`: one sentence per group, its figure); in the
+appendix the best-method figure ``scenarios_best`` (the report's main text opens with it) and
+table, the per-method and the per-scenario tables. Numbers come from the tables; nothing is a
+claim. The prose is in the templates ``section.md`` (main text) and ``appendix.md`` beside this
+module."""
 
 from __future__ import annotations
 
@@ -10,24 +13,93 @@ from typing import Any
 
 import pandas as pd
 
+from rsmhp.models.uav import methods
 from rsmhp.report.ledger import Section
-from rsmhp.report.markdown import ci_cells, fmt, markdown_table
+from rsmhp.report.markdown import ci_cells, fmt, markdown_table, param_text
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import render
+from rsmhp.studies.scenarios.best import BUDGET, GROUPS, HORIZON, SCENARIO
 from rsmhp.studies.scenarios.summarise import ALL_GROUP
 
-__all__ = ["ORDER", "TABLES", "scenarios_section", "scenarios_tables"]
+__all__ = [
+    "GROUP_NAMES",
+    "ORDER",
+    "TABLES",
+    "best_table",
+    "config_label",
+    "family_label",
+    "scenarios_section",
+    "scenarios_tables",
+]
 
 #: after the long-horizon and optimiser sections
 ORDER = 35
 #: table stems (results/tables/<stem>.md)
-TABLES = ("scenarios_improvement", "scenarios_per_scenario")
+TABLES = ("scenarios_best", "scenarios_improvement", "scenarios_per_scenario")
+
+#: how the text and the table name each group of :data:`rsmhp.studies.scenarios.best.GROUPS`
+GROUP_NAMES = {
+    BUDGET: "equal compute, per budget",
+    HORIZON: "long horizons, per H",
+    SCENARIO: "map scenarios (H = 6), per cell",
+}
 
 
-def scenarios_tables(summary: pd.DataFrame, per: pd.DataFrame) -> dict[str, str]:
-    """``scenarios_improvement`` (per group and method: scenarios, probability of improvement over
-    NBO with its 95% interval, share of scenarios above 1/2) and ``scenarios_per_scenario`` (per
-    scenario and method: paired runs, probability, mean difference)."""
+def config_label(method: str, member: str) -> str:
+    """A method's label (:func:`rsmhp.report.palette.method_label` of its ``member``), with the
+    optimiser budget of a configuration (``rsmhp_nt16/it300/r1``: ``RS-MHP N_T=16 (it300/r1)``)."""
+    label = method_label(member)
+    if method != member and method.startswith(f"{member}/"):
+        return f"{label} ({method[len(member) + 1 :]})"
+    return label
+
+
+def _axis_text(group: str, value: float) -> str:
+    text = param_text(value)
+    return {BUDGET: f"{text} ms", HORIZON: f"H = {text}", SCENARIO: f"q = {text}"}.get(group, text)
+
+
+def best_table(best: pd.DataFrame, paired: pd.DataFrame) -> str:
+    """``scenarios_best``: one row per cell of the figure (group, row, column, runs, methods):
+    the best method and its mean error, the runner-up with its paired difference from the best
+    and the 95% t interval, every method tied with the best, and whether the best is clear."""
+    labels = {
+        (r.group, r.model, r.value, r.method): config_label(r.method, r.member)
+        for r in paired.itertuples(index=False)
+    }
+
+    def tied(r) -> str:
+        names = [] if pd.isna(r.tied) else [m for m in str(r.tied).split(";") if m]
+        return ", ".join(labels[(r.group, r.model, r.value, m)] for m in names) or "none"
+
+    t = pd.DataFrame(
+        {
+            "group": best["group"].map(lambda g: GROUP_NAMES.get(g, g)),
+            "row": best["model"],
+            "column": [_axis_text(g, a) for g, a in zip(best["group"], best["value"], strict=True)],
+            "runs": best["runs"].astype(int),
+            "methods": best["methods"].astype(int),
+            "best": [config_label(m, b) for m, b in
+                     zip(best["best"], best["best_member"], strict=True)],
+            "its mean error (m)": best["best_mean"],
+            "runner-up": [config_label(m, b) for m, b in
+                          zip(best["runner_up"], best["runner_up_member"], strict=True)],
+            "runner-up − best (m)": best["runner_up_diff"],
+            "95% CI": ci_cells(best["runner_up_low"], best["runner_up_high"], signed=True),
+            "tied with the best": [tied(r) for r in best.itertuples(index=False)],
+            "clear": best["clear"].map({True: "yes", False: "no"}),
+        }
+    )  # fmt: skip
+    return markdown_table(t, digits=3, signed=("runner-up − best (m)",))
+
+
+def scenarios_tables(
+    summary: pd.DataFrame, per: pd.DataFrame, best: pd.DataFrame, paired: pd.DataFrame
+) -> dict[str, str]:
+    """``scenarios_best`` (:func:`best_table`), ``scenarios_improvement`` (per group and method:
+    scenarios, probability of improvement over NBO with its 95% interval, share of scenarios
+    above 1/2) and ``scenarios_per_scenario`` (per scenario and method: paired runs,
+    probability, mean difference)."""
     t = pd.DataFrame(
         {
             "scenarios": summary["group"],
@@ -48,6 +120,7 @@ def scenarios_tables(summary: pd.DataFrame, per: pd.DataFrame) -> dict[str, str]
         }
     )
     return {
+        "scenarios_best": best_table(best, paired),
         "scenarios_improvement": markdown_table(t, digits=3),
         "scenarios_per_scenario": markdown_table(p, digits=3, signed=("mean error − NBO's (m)",)),
     }
@@ -94,29 +167,97 @@ def _group_text(summary: pd.DataFrame, group: str) -> GroupText:
     )
 
 
+@dataclass(frozen=True)
+class BestText:
+    """What the main text says of one group of the best-method grid: its cells and runs per
+    cell, how many have a clear best and the families of those (``label in count``, most
+    frequent first), how many are tied and the range of tied methods there, and the family
+    that is best in the most cells (every one of them on a tie, with the count)."""
+
+    name: str
+    cells: int
+    runs: str
+    clear: int
+    clear_best: str
+    tied: int
+    tie_range: str
+    top: str
+
+
+def _counts(labels: list[str]) -> list[tuple[str, int]]:
+    """``(label, count)``, most frequent first (ties: first seen)."""
+    counts = {lab: labels.count(lab) for lab in dict.fromkeys(labels)}
+    return sorted(counts.items(), key=lambda kv: -kv[1])
+
+
+def family_label(family: str) -> str:
+    """A registered family's label (``dpw``: ``tree search``); the name itself otherwise."""
+    fams = {c.family: c for c in methods.families()}
+    return fams[family].family_label if family in fams else str(family)
+
+
+def _best_text(best: pd.DataFrame, group: str) -> BestText:
+    """The group's sentence values from the best-method table, by family (the figure's colours;
+    the members and their optimiser budgets are in the appendix table)."""
+    g = best[best["group"] == group]
+    labels = [family_label(f) for f in g["best_family"]]
+    clear = g["clear"].astype(bool).to_numpy()
+    runs = sorted(set(g["runs"].astype(int)))
+    tied = g.loc[~clear, "n_tied"].astype(int).tolist()
+    winners = [lab for lab, c in zip(labels, clear, strict=True) if c]
+    counts = _counts(labels)
+    top_n = counts[0][1]
+    top = [lab for lab, n in counts if n == top_n]  # every family at the highest count
+    if not tied:
+        tie_range = ""
+    elif min(tied) == max(tied):
+        tie_range = f"{min(tied)} other method{'s' if min(tied) > 1 else ''}"
+    else:
+        tie_range = f"{min(tied)} to {max(tied)} other methods"
+    return BestText(
+        name=GROUP_NAMES.get(group, group),
+        cells=len(g),
+        runs=str(runs[0]) if len(runs) == 1 else f"{runs[0]} to {runs[-1]}",
+        clear=int(clear.sum()),
+        clear_best=", ".join(f"{lab} in {n}" for lab, n in _counts(winners)),
+        tied=len(tied),
+        tie_range=tie_range,
+        top=" and ".join(top) + f" ({top_n} of {len(g)}{' each' if len(top) > 1 else ''})",
+    )
+
+
 def _render(template: str, **values: Any) -> str:
     """``template`` filled with ``values``, without the newline that ends the file."""
     return render(__package__, template, **values).removesuffix("\n")
 
 
-def scenarios_section(summary: pd.DataFrame, tables: dict[str, str]) -> Section:
+def scenarios_section(summary: pd.DataFrame, tables: dict[str, str], best: pd.DataFrame) -> Section:
     """The section (order :data:`ORDER`; text in ``section.md`` and ``appendix.md``): in the
-    main text the probability of improvement over NBO of every method on each group of
-    scenarios, the figure; the tables in the appendix."""
+    main text the best method per cell of each group (``best``,
+    :data:`rsmhp.studies.scenarios.best.BEST_COLUMNS`), then the probability of improvement
+    over NBO of every method on each group of scenarios with its figure; in the appendix the
+    best-method figure (listed in ``figures``: the report's main text opens with it,
+    :data:`rsmhp.report.render.SUMMARY_FIGURE`) and the tables."""
     groups = [g for g in dict.fromkeys(summary["group"]) if g != ALL_GROUP]
+    best_groups = [g for g in GROUPS if g in set(best["group"])]
+    best_groups += [g for g in dict.fromkeys(best["group"]) if g not in best_groups]
     return Section(
         key="scenarios",
-        title="Across scenarios: probability of beating NBO",
+        title="Across scenarios: the best method per cell, and the probability of beating NBO",
         order=ORDER,
         body=_render(
             "section.md",
+            best=[_best_text(best, g) for g in best_groups],
             empty=summary.empty,
             groups=[_group_text(summary, g) for g in groups],
         ),
-        figures=["scenarios_improvement"],
+        figures=["scenarios_best", "scenarios_improvement"] if len(best) else
+        ["scenarios_improvement"],
         appendix=_render(
             "appendix.md",
+            has_best=not best.empty,
+            best_table=tables["scenarios_best"],
             improvement_table=tables["scenarios_improvement"],
             per_scenario_table=tables["scenarios_per_scenario"],
         ),
-    )
+    )  # fmt: skip
