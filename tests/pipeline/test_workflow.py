@@ -124,13 +124,22 @@ def test_recording_and_report(run_j2, tiny):
     claims = json.loads((run_j2 / "results/paper/claims.json").read_text())
     by_id = {c["id"]: c for c in claims["claims"]}
     for cid in ("LQG-1", "LQG-2", "LQG-3", "LQG-4"):
-        assert f"| {cid} |" in report and f"### {cid} ({by_id[cid]['verdict']})" in appendix
+        assert f"| {cid} |" in appendix and f"### {cid}\n\n- Verdict: **" in appendix
         assert by_id[cid]["key"]["reproducible"] == "bitwise"
-    # the glance table: the paper's statements, then the claims beyond the paper
+    # the one page: findings, statements, main claims; the checks counted apart
+    assert report.index("## What we found") < report.index("## The paper's statements")
+    assert len(report.encode()) <= 25_000
+    checks = [cid for cid, c in by_id.items() if c.get("check")]
+    assert {"LQG-1", "LQG-3", "LIN-1"} <= set(checks)
+    assert f"{len(checks)} checks of our simulation" in appendix
+    # the glance table: the paper's statements, then the benchmark's own main claims
     glance = (run_j2 / "results/paper/glance.md").read_text()
-    beyond = [cid for cid, c in by_id.items() if c["part"] == "beyond"]
     statements = [st["id"] for st in claims["statements"]]
-    assert [line.split(" | ")[0][2:] for line in glance.splitlines()[2:]] == statements + beyond
+    first = glance.split("\n\n")[0]
+    assert [line.split(" | ")[0][2:] for line in first.splitlines()[2:]] == statements
+    # the HTML report's landing page: the same findings
+    summary = (run_j2 / "results/paper/summary.html").read_text()
+    assert "<h2>What we found</h2>" in summary and summary.count("<li>") <= 7
     # every claim of the paper is evidence of exactly the statements that list it
     counted = {cid for st in claims["statements"] for cid in st["counted"] + st["alongside"]}
     assert {cid for cid, c in by_id.items() if c["part"] == "paper"} <= counted
@@ -224,11 +233,11 @@ def test_estimator_study_outputs(run_j2, tiny):
     ):
         assert (run_j2 / f"results/figures/{name}.png").read_bytes()[:4] == b"\x89PNG"
         assert (run_j2 / f"results/paper/figures/{name}.png").exists()
-    report = (run_j2 / "results/paper/replication.md").read_text()
+    report = (run_j2 / "results/paper/appendix.md").read_text()  # sections and ledger
     for cid in ("EST-1", "EST-2", "EST-3", "EST-4"):
         assert f"| {cid} |" in report
     # sections in report order: LQG (10) before the estimator study (15)
-    assert report.index("## Case study 1") < report.index("## Estimator study")
+    assert report.index(". Case study 1") < report.index(". Estimator study")
     rec = est["recording"]
     counts: dict[str, int] = {}
     for chunk in RrdReader(run_j2 / "results/recordings/estimators_tree.rrd").store().stream():
@@ -316,7 +325,7 @@ def test_decision_study_outputs(run_j2, tiny, tmp_path):
     )
     assert (df["regret"] >= 0).all()
     assert df.loc[df.method == "nbo", "regret"].max() < 1e-12
-    report = (run_j2 / "results/paper/replication.md").read_text()
+    report = (run_j2 / "results/paper/appendix.md").read_text()  # sections and ledger
     for cid in ("DEC-1", "DEC-2", "DEC-3"):
         assert f"| {cid} |" in report
     assert "](figures/decisions_lqg_regret.png)" in report
@@ -345,8 +354,8 @@ def test_frontier_outputs(run_j2, tiny):
     png = (run_j2 / "results/figures/frontier_exploratory.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
     # in the report: section, claims FR-1..3 per model, figure, both tables
-    report = (run_j2 / "results/paper/replication.md").read_text()
-    assert report.index("## Decision quality: UAV") < report.index("## Planners at equal compute")
+    report = (run_j2 / "results/paper/appendix.md").read_text()  # sections and ledger
+    assert report.index(". Decision quality: UAV") < report.index(". Planners at equal compute")
     for model in cfg["models"]:
         for k in (1, 2, 3):
             assert f"| FR-{k}-{model} |" in report
@@ -356,7 +365,7 @@ def test_frontier_outputs(run_j2, tiny):
         text = (run_j2 / f"results/tables/{table}.md").read_text()
         assert text.strip() and text.strip() in appendix
     # the exploratory design (tiny: exploratory: true) has its section, never claims
-    assert "## Planners at equal compute: the exploratory design" in report
+    assert ". Planners at equal compute: the exploratory design" in report
 
 
 def test_confirm_outputs(run_j2, tiny):
@@ -398,8 +407,8 @@ def test_confirm_outputs(run_j2, tiny):
     fr = [c for c in data["claims"] if c["id"].startswith("FR-")]
     assert fr and all(f"sha256 {sha[:12]}" in c["rule"] for c in fr)
     assert all(c["key"]["p_value"] is not None and c["key"]["p_holm"] is not None for c in fr)
-    report = (run_j2 / "results/paper/replication.md").read_text()
-    assert "## Planners at equal compute (confirmatory)" in report
+    report = (run_j2 / "results/paper/appendix.md").read_text()  # sections and ledger
+    assert ". Planners at equal compute (confirmatory)" in report
     assert "](figures/frontier_confirm.png)" in report
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
     assert "76a0c01" in appendix
@@ -421,8 +430,8 @@ def test_horizon_outputs(run_j2, tiny):
             assert (r["plan_ms"] > 0).all()
     summary = pd.read_csv(run_j2 / "results/horizon/uav_approx_summary.csv")
     assert set(summary["H"]) == set(cfg["H"]) and (summary["rel_rmse"] >= 0).all()
-    report = (run_j2 / "results/paper/replication.md").read_text()
-    assert report.index("## Planners at equal compute") < report.index("## Long horizons")
+    report = (run_j2 / "results/paper/appendix.md").read_text()  # sections and ledger
+    assert report.index(". Planners at equal compute") < report.index(". Long horizons")
     for model in cfg["models"]:
         for cid in (f"HZ-1-{model}", f"HZ-2-{model}", f"HZ-3-{model}"):
             assert f"| {cid} |" in report
@@ -451,8 +460,8 @@ def test_scenarios_outputs(run_j2, tiny):
     assert "nbo" not in set(per["method"]) and per["p_improve"].between(0, 1).all()
     summary = pd.read_csv(run_j2 / "results/scenarios/summary.csv")
     assert (summary["low"] <= summary["p_improve"]).all()
-    report = (run_j2 / "results/paper/replication.md").read_text()
-    assert report.index("## Optimiser error apart") < report.index("## Across scenarios")
+    report = (run_j2 / "results/paper/appendix.md").read_text()  # sections and ledger
+    assert report.index(". Optimiser error apart") < report.index(". Across scenarios")
     assert "](figures/scenarios_improvement.png)" in report
     assert (run_j2 / "results/paper/figures/scenarios_improvement.png").read_bytes()[
         :4
@@ -473,7 +482,7 @@ def test_horizon_lqg_outputs(run_j2, tiny):
     assert (pruned["N"] ** pruned["H"] > pruned["M"]).all()
     reg = pd.read_csv(run_j2 / "results/horizon/lqg_regret_summary.csv")
     assert set(reg["H"]) == set(cfg["sim_H"]) and reg["limit"].notna().any()
-    report = (run_j2 / "results/paper/replication.md").read_text()
+    report = (run_j2 / "results/paper/appendix.md").read_text()  # sections and ledger
     for cid in ("HZ-4", "HZ-5"):
         assert f"| {cid} |" in report
     assert (run_j2 / "results/paper/figures/horizon_lqg.png").read_bytes()[:4] == b"\x89PNG"
@@ -546,7 +555,7 @@ def test_uav_decision_outputs(run_j2, tiny):
         runs = pd.read_csv(run_j2 / f"results/decisions/map/{cell}.csv")
         assert len(runs) == cfg["map"]["runs"] * (1 + len(compared))
         assert (run_j2 / f"results/benchmarks/decisions_map_cell/{cell}.tsv").exists()
-    report = (run_j2 / "results/paper/replication.md").read_text()
+    report = (run_j2 / "results/paper/appendix.md").read_text()  # sections and ledger
     for cid in ("DEC-6", "DEC-8a", "DEC-8b"):
         assert f"| {cid} |" in report
     for name in ("decisions_uav_regret", "decisions_uav_map"):
@@ -633,7 +642,9 @@ def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, 
     figures = [p.stem for p in (run_j2 / "results/figures").glob("*.png")]
     tables = [p.stem for p in (run_j2 / "results/tables").glob("*.md")]
     assert len(figures) == 26 and len(tables) == 31
-    assert {c.stem for c in captions} == set(figures) | {f"table_{t}" for t in tables}
+    pages = {"workflow", "summary"}  # the landing page and the summary's caption
+    assert {c.stem for c in captions} - pages == set(figures) | {f"table_{t}" for t in tables}
+    assert "What we found" in html  # the landing page includes results/paper/summary.html
     for name in figures:
         assert f"{name}.png" in html, name
     for name in tables:

@@ -190,7 +190,8 @@ def _claim_phrase(c: Claim, appendix: str) -> str:
 
 def best_sentence(best: pd.DataFrame | None) -> str:
     """Which family is best where, from the summary table ``best`` (columns ``group``,
-    ``model``, ``value``, ``best``, ``clear``; rows in the figure's order): per group and
+    ``model``, ``value``, ``best`` (or its label ``best_label``), ``clear``; rows in the
+    figure's order): per group and
     model the runs of equal best method over the axis, each with how many of its cells the
     best is clear in. Empty without a table."""
     if best is None or best.empty:
@@ -203,11 +204,12 @@ def best_sentence(best: pd.DataFrame | None) -> str:
         for _, r in g.iterrows():
             value = r["value"]
             value = param_text(value) if isinstance(value, int | float) else str(value)
-            if runs and runs[-1][0] == r["best"]:
+            name = r["best_label"] if "best_label" in r.index else r["best"]
+            if runs and runs[-1][0] == name:
                 runs[-1][1].append(value)
                 runs[-1][2] += bool(r["clear"])
             else:
-                runs.append([r["best"], [value], int(bool(r["clear"]))])
+                runs.append([name, [value], int(bool(r["clear"]))])
         segs = []
         for name, vals, clear in runs:
             span = vals[0] if len(vals) == 1 else f"{vals[0]} to {vals[-1]}"

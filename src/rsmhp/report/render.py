@@ -288,8 +288,9 @@ def _studies_part(sections: Sequence[Section]) -> list[str]:
 
 #: the caption of the summary figure (main text and the HTML report's landing page)
 SUMMARY_CAPTION = (
-    "The family with the lowest closed-loop error per cell (solid: better than every other "
-    "family, paired 95% CI; hatched: tied, with the number of families tied)."
+    "The method with the lowest mean closed-loop error per cell, in its family's colour "
+    "(solid: better than every other method, paired 95% t CI over runs; hatched: tied, with "
+    "the number of methods tied)."
 )
 
 

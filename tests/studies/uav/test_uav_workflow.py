@@ -69,10 +69,11 @@ def test_uav_summary_tables_figures_report(run_j2, tiny):
     report = (run_j2 / "results/paper/replication.md").read_text()
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
     for cid in ("UAV-1", "UAV-2", "UAV-3"):
-        assert f"| {cid} |" in report and f"### {cid} (" in appendix
-    assert "## Case study 2: UAV target tracking" in report
+        assert f"| {cid} |" in appendix and f"### {cid}\n" in appendix
+        assert f"[{cid}](appendix.md#{cid.lower()})" in report  # linked from the one page
+    assert ". Case study 2: UAV target tracking" in appendix
     for name in FIGURES:
-        assert f"](figures/{name}.png)" in report
+        assert f"](figures/{name}.png)" in appendix and f"[{name}](figures/{name}.png)" in report
     big = summary[summary["family"] == "rsmhp"].sort_values("N_T").iloc[-1]
     assert f"{big['label']} {fmt(big['mean'], 4)} m" in appendix
     section = Section.load(run_j2 / "results/report/uav.json")

@@ -35,6 +35,7 @@ methods or across cells): "clear" is a descriptive flag, not a claim.
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -62,6 +63,7 @@ __all__ = [
     "footprint_label",
     "horizon_runs",
     "scenario_runs",
+    "short_label",
 ]
 
 BUDGET = "budget"
@@ -86,8 +88,8 @@ BEST_RUN_COLUMNS = ["group", "model", "value", "method", "member", "family", "ru
 REQUIRED = ["group", "model", "value", "method", "run", "error"]
 #: one row per cell (:func:`best_family`); ``tied`` the tied methods joined by ``;``
 BEST_COLUMNS = [
-    "group", "model", "value", "runs", "methods", "best", "best_member", "best_family",
-    "best_mean", "runner_up", "runner_up_member", "runner_up_mean", "runner_up_diff",
+    "group", "model", "value", "runs", "methods", "best", "best_member", "best_label",
+    "best_family", "best_mean", "runner_up", "runner_up_member", "runner_up_mean", "runner_up_diff",
     "runner_up_low", "runner_up_high", "tied", "n_tied", "clear",
 ]  # fmt: skip
 #: one row per (cell, method other than the best): the paired difference method − best
@@ -217,7 +219,9 @@ def best_family(runs: pd.DataFrame, level: float = 0.95) -> Best:
         cells.append({
             "group": group, "model": model, "value": value, "runs": int(wide.shape[0]),
             "methods": int(wide.shape[1]), "best": best,
-            "best_member": first.loc[best, "member"], "best_family": first.loc[best, "family"],
+            "best_member": first.loc[best, "member"],
+            "best_label": short_label(first.loc[best, "member"]),
+            "best_family": first.loc[best, "family"],
             "best_mean": float(means[best]), "runner_up": second["method"],
             "runner_up_member": second["member"], "runner_up_mean": second["mean"],
             "runner_up_diff": second["mean_diff"], "runner_up_low": second["low"],
@@ -226,6 +230,19 @@ def best_family(runs: pd.DataFrame, level: float = 0.95) -> Best:
         })  # fmt: skip
     return Best(pd.DataFrame(cells, columns=BEST_COLUMNS),
                 pd.DataFrame(paired, columns=PAIRED_COLUMNS))  # fmt: skip
+
+
+def short_label(member: str) -> str:
+    """A method's label short enough for a cell: its registry label (``RS-MHP N_T=256``,
+    ``pruned tree N=4 M=256``, ``tree search 100 sims (k_a=2, ...)``) without ``N_T=``, the
+    word ``sims`` and any parenthesis, a pruned tree as ``pruned 4×256``; the name itself if
+    no family knows it."""
+    try:
+        text = methods.from_name(str(member)).label()
+    except ValueError:
+        return str(member)
+    text = re.sub(r"\s*\(.*\)\s*$", "", text).replace("N_T=", "").replace(" sims", "")
+    return re.sub(r"pruned tree N=(\d+) M=(\d+)", r"pruned \1×\2", text)
 
 
 # ------------------------------------------------------------------ the three groups' runs

@@ -12,8 +12,6 @@
 
 from __future__ import annotations
 
-import re
-
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
@@ -23,7 +21,7 @@ from matplotlib.patches import Patch, Rectangle
 from rsmhp.models.uav import methods
 from rsmhp.report.figures import theme
 from rsmhp.report.palette import METHOD_COLOURS, member_colour, method_label
-from rsmhp.studies.scenarios.best import BUDGET, GROUPS, HORIZON, SCENARIO
+from rsmhp.studies.scenarios.best import BUDGET, GROUPS, HORIZON, SCENARIO, short_label
 
 __all__ = ["FIGURES", "best_figure", "family_colour", "improvement_figure", "short_label"]
 
@@ -73,19 +71,6 @@ _TITLES = {
 }
 #: how much a tied cell's colour is mixed with white
 _FADE = 0.6
-
-
-def short_label(member: str) -> str:
-    """A method's label short enough for a cell: its registry label (``RS-MHP N_T=256``,
-    ``pruned tree N=4 M=256``, ``tree search 100 sims (k_a=2, ...)``) without ``N_T=``, the
-    word ``sims`` and any parenthesis, a pruned tree as ``pruned 4×256``; the name itself if
-    no family knows it."""
-    try:
-        text = methods.from_name(str(member)).label()
-    except ValueError:
-        return str(member)
-    text = re.sub(r"\s*\(.*\)\s*$", "", text).replace("N_T=", "").replace(" sims", "")
-    return re.sub(r"pruned tree N=(\d+) M=(\d+)", r"pruned \1×\2", text)
 
 
 def family_colour(family: str, member: str | None = None) -> str:
