@@ -38,10 +38,8 @@ Sub-packages
                     pre-flight), protocol (seed streams, planner configurations, tuning rule,
                     preregistration), script (logging and code checks of rule scripts)
   report            ledger (KeyNumber, Claim, Section), verdicts (verdict rules as objects),
-                    statements (the paper's statements judged on its setups and on variants),
-                    findings (the main claims, "What we found"), power (runs at 80% power),
-                    history (earlier verdicts, fragility), render (main text, appendix,
-                    glance table), html (the HTML report's landing page), templates (Jinja2),
+                    statements (the paper's statements and their evidence), render (main text,
+                    appendix, claims, glance table), templates (Jinja2 section templates),
                     markdown (number formatting, tables), palette (one colour and label per
                     method), figures (theme, save_figure), provenance, readme (``make
                     publish``), verify (``make verify``), portability (``make portability``)
