@@ -281,7 +281,8 @@ def _main_claims_part(
 def _studies_part(sections: Sequence[Section]) -> list[str]:
     lines = ["## The studies", "", "| study | figures | details |", "|---|---|---|"]
     for i, s in enumerate(sections, start=1):
-        figs = ", ".join(f"[{f}](figures/{f}.png)" for f in s.figures) or "–"
+        names = [f.removesuffix(".png") for f in s.figures]
+        figs = ", ".join(f"[{f}](figures/{f}.png)" for f in names) or "–"
         lines.append(f"| {s.title} | {figs} | appendix C{i} |")
     return [*lines, ""]
 
