@@ -60,20 +60,24 @@ def test_main_rows_put_the_setups_side_by_side_with_power():
     assert "→ **supported**; n = 80, " in paper and fp.startswith("**UAV footprint150**")
 
 
-def test_best_sentence_merges_equal_neighbours():
+def test_best_sentence_names_clear_bests_and_where_none_is():
     best = pd.DataFrame(
         {
-            "group": ["budget"] * 3 + ["horizon"] * 2,
-            "model": ["paper"] * 5,
-            "value": [0.5, 1, 2, 2, 24],
-            "best": ["tree", "tree", "sigma", "NBO", "RQMC"],
-            "clear": [True, False, True, False, False],
+            "group": ["budget"] * 4 + ["horizon"] * 2,
+            "model": ["paper"] * 6,
+            "value": [0.5, 1, 2, 4, 2, 24],
+            "best": ["tree", "tree", "sigma", "tree", "NBO", "RQMC"],
+            "clear": [True, True, False, True, False, False],
         }
     )
     assert best_sentence(best) == (
-        "by budget on 'paper': tree at 0.5 to 1 ms (clear in 1 of 2), sigma at 2 ms (clear in "
-        "1 of 1); by horizon on 'paper': NBO at H = 2 (clear in 0 of 1), RQMC at H = 24 "
-        "(clear in 0 of 1)"
+        "by budget on 'paper': tree at 0.5 to 1 ms, tree at 4 ms, no clear best at 2 ms; "
+        "by horizon on 'paper': no clear best in any of its 2 cells"
+    )
+    labelled = best.assign(best_label=["T"] * 6, clear=[True, False, False, True, True, True])
+    assert best_sentence(labelled).startswith(
+        "by budget on 'paper': T at 0.5 ms, T at 4 ms, no clear best at 1 to 2 ms; "
+        "by horizon on 'paper': T at H = 2 to 24"
     )
     assert best_sentence(None) == ""
 

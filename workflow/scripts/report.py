@@ -66,7 +66,6 @@ with rule_logging(snakemake) as log:
             what_we_found(sections, best=best),
             figure,
             SUMMARY_CAPTION if figure else "",
-            title="rsmhp replication report",
         ),
         snakemake.output.summary,
     )

@@ -188,35 +188,47 @@ def _claim_phrase(c: Claim, appendix: str) -> str:
     return f"{link(c.id, appendix)} {key_text(c)}, {verdict_text(c)}"
 
 
+def _span(values: Sequence[str], prefix: str, unit: str) -> str:
+    inner = values[0] if len(values) == 1 else f"{values[0]} to {values[-1]}"
+    return f"{prefix}{inner}{unit}"
+
+
 def best_sentence(best: pd.DataFrame | None) -> str:
-    """Which family is best where, from the summary table ``best`` (columns ``group``,
-    ``model``, ``value``, ``best`` (or its label ``best_label``), ``clear``; rows in the
-    figure's order): per group and
-    model the runs of equal best method over the axis, each with how many of its cells the
-    best is clear in. Empty without a table."""
+    """Which method is clearly best where, from the summary table ``best`` (columns
+    ``group``, ``model``, ``value``, ``best`` (or its label ``best_label``), ``clear``; rows
+    in the figure's order): per group and model the runs of neighbouring cells where the same
+    method is clearly best, then the cells without a clear best (a tied best is no
+    recommendation). Empty without a table."""
     if best is None or best.empty:
         return ""
-    unit = {"budget": " ms", "horizon": "", "scenario": ""}
-    prefix = {"budget": "", "horizon": "H = ", "scenario": ""}
+    unit = {"budget": " ms"}
+    prefix = {"horizon": "H = ", "scenario": "q = "}
     parts = []
     for (group, model), g in best.groupby(["group", "model"], sort=False):
-        runs: list[list[Any]] = []
-        for _, r in g.iterrows():
+        pre, post = prefix.get(group, ""), unit.get(group, "")
+        clear: list[list[Any]] = []  # [label, values, last position]
+        unclear: list[list[Any]] = []  # [values, last position]
+        for pos, (_, r) in enumerate(g.iterrows()):
             value = r["value"]
             value = param_text(value) if isinstance(value, int | float) else str(value)
             name = r["best_label"] if "best_label" in r.index else r["best"]
-            if runs and runs[-1][0] == name:
-                runs[-1][1].append(value)
-                runs[-1][2] += bool(r["clear"])
+            if bool(r["clear"]):
+                if clear and clear[-1][0] == name and clear[-1][2] == pos - 1:
+                    clear[-1][1].append(value)
+                    clear[-1][2] = pos
+                else:
+                    clear.append([name, [value], pos])
+            elif unclear and unclear[-1][1] == pos - 1:
+                unclear[-1][0].append(value)
+                unclear[-1][1] = pos
             else:
-                runs.append([name, [value], int(bool(r["clear"]))])
-        segs = []
-        for name, vals, clear in runs:
-            span = vals[0] if len(vals) == 1 else f"{vals[0]} to {vals[-1]}"
-            segs.append(
-                f"{name} at {prefix.get(group, '')}{span}{unit.get(group, '')} "
-                f"(clear in {clear} of {len(vals)})"
-            )
+                unclear.append([[value], pos])
+        segs = [f"{name} at {_span(vals, pre, post)}" for name, vals, _ in clear]
+        if unclear and not clear:
+            segs.append(f"no clear best in any of its {len(g)} cells")
+        elif unclear:
+            spans = ", ".join(_span(u, pre, post) for u, _ in unclear)
+            segs.append(f"no clear best at {spans}")
         parts.append(f"by {group} on '{model}': " + ", ".join(segs))
     return "; ".join(parts)
 
@@ -246,7 +258,7 @@ def found_values(
         if not got:
             return ""
         inner = "; ".join(f"{lab}: {_claim_phrase(c, appendix)}" for lab, c in got)
-        return f"{m.says} ({inner})"
+        return f"'{m.says}' ({inner})"
 
     return {
         "n_statements": len(judgements),
