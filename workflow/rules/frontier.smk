@@ -7,7 +7,14 @@ from rsmhp.studies.frontier.figures import CONFIRM_FIGURES
 from rsmhp.studies.frontier.figures import FIGURES as FRONTIER_FIGURES
 from rsmhp.studies.frontier.section import CONFIRM_TABLES
 from rsmhp.studies.frontier.section import TABLES as FRONTIER_TABLES
-from rsmhp.pipeline.protocol import confirm_plan
+from rsmhp.pipeline.protocol import Configuration, confirm_plan, tuned_configurations
+from rsmhp.studies.frontier.reference import (
+    check_reference,
+    ladder_rows,
+    load_reference,
+    method_sources,
+    scenario_fingerprint,
+)
 
 FRONTIER = config["frontier"]
 FRONTIER_FAMILIES = families_of(FRONTIER["methods"], "frontier.methods")
@@ -407,7 +414,168 @@ rule frontier_confirm_figures:
 
 
 rule frontier:
-    """Target: the equal-compute study's confirmatory run (tables, section, figure; nothing without a preregistration)."""
+    """Target: the equal-compute study's confirmatory run (tables, section, figure, the reference of make compare; nothing without a preregistration)."""
     input:
         rules.frontier_confirm_summary.output if CONFIRM_MODELS else [],
         rules.frontier_confirm_figures.output if CONFIRM_MODELS else [],
+        (
+            [
+                "results/frontier/reference/frontier_confirm_runs.parquet",
+                "results/frontier/reference/frontier_confirm.json",
+            ]
+            if CONFIRM_MODELS
+            else []
+        ),
+
+
+# ---------------------------------------------------------------------------------------
+# The published reference and the comparison of new planners with it (make compare):
+# the confirmatory run's per-run table with the fingerprint of its scenarios
+# (rsmhp.studies.frontier.reference), and new methods (config plugin_methods) run on the same
+# scenarios and paired with it run by run (rsmhp.studies.frontier.compare).
+REFERENCE_DIR = "paper/reference"
+COMPARE_METHODS = list(config["plugin_methods"])
+if CONFIRM is not None:
+    # what makes a run the same scenario: the confirmatory rule's code without any method
+    # family, and its configuration (not the plan: the methods are what differs)
+    SCENARIO = scenario_fingerprint(
+        code_digest("workflow/scripts/frontier_confirm.py", []),
+        {
+            "uav": pick(config["uav"], *UAV_MODEL_KEYS),
+            "models": canonical(config["decisions"]["uav"]["models"]),
+            "runs": CONFIRM["runs"],
+            "stream": CONFIRM["stream"],
+            "seed": config["seed"],
+            "track_loss_error": FRONTIER["track_loss_error"],
+        },
+    )
+    LADDER = ladder_rows(
+        {
+            m: {
+                b: {f: c.name for f, c in fams.items()}
+                for b, fams in tuned_configurations(CONFIRM["tuned"], m).items()
+                if float(b)
+                in [float(x) for x in CONFIRM["preregistration"]["budgets_ms"]]
+            }
+            for m in CONFIRM_MODELS
+        }
+    )
+    REFERENCE_MARGIN = float(
+        CONFIRM["preregistration"]["claims"]["FR-1"].get("margin_m", 0.25)
+    )
+if COMPARE_METHODS:
+    # refuse a comparison that would not be paired, before any job runs
+    if CONFIRM is None:
+        sys.exit(
+            "plugin_methods: the comparison needs the confirmatory design "
+            "(frontier.models and the preregistration), and this config has none"
+        )
+    try:
+        _, REFERENCE_META = load_reference(REFERENCE_DIR)
+        for _m in COMPARE_METHODS:
+            Configuration(_m)  # refuses a name no registered family parses
+    except ValueError as exc:
+        sys.exit(f"plugin_methods: {exc}")
+    _problems = check_reference(REFERENCE_META, SCENARIO, CONFIRM_MODELS)
+    if _problems:
+        sys.exit(
+            f"plugin_methods: the published reference ({REFERENCE_DIR}) ran other scenarios "
+            "than this workflow, so its runs would not pair with the new method's; refused. "
+            "What differs:\n  - " + "\n  - ".join(_problems)
+        )
+
+
+rule frontier_reference:
+    """Protocol, confirmatory run: its per-run table in compact form (Parquet) with the fingerprint of its scenarios, the reference new planners are paired with (make publish copies it to paper/reference/)."""
+    input:
+        runs=expand("results/frontier/confirm/{model}.csv", model=CONFIRM_MODELS),
+    output:
+        runs="results/frontier/reference/frontier_confirm_runs.parquet",
+        meta="results/frontier/reference/frontier_confirm.json",
+    log:
+        "results/logs/frontier_reference.log",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        scenario=SCENARIO if CONFIRM is not None else None,
+        ladder=LADDER if CONFIRM is not None else None,
+        preregistration=(
+            {
+                "path": CONFIRM["path"],
+                "sha256": CONFIRM["sha256"],
+                "margin_m": REFERENCE_MARGIN,
+                "headline_budget_ms": CONFIRM["preregistration"]["headline_budget_ms"],
+            }
+            if CONFIRM is not None
+            else None
+        ),
+        code=code_digest("workflow/scripts/frontier_reference.py"),
+    script:
+        "../scripts/frontier_reference.py"
+
+
+rule frontier_compare_run:
+    """A new planner (config plugin_methods) on the confirmatory design's scenarios of one model: the same runs, seed stream and configuration as the published reference."""
+    output:
+        "results/compare/runs/{model}.csv",
+    log:
+        "results/logs/frontier_compare_run/{model}.log",
+    benchmark:
+        "results/benchmarks/frontier_compare_run/{model}.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=60,
+    params:
+        uav=pick(config["uav"], *UAV_MODEL_KEYS),
+        models=canonical(config["decisions"]["uav"]["models"]),
+        methods=COMPARE_METHODS,
+        runs=lambda w: CONFIRM["runs"][w.model],
+        stream=CONFIRM["stream"] if CONFIRM is not None else None,
+        track_loss_error=FRONTIER["track_loss_error"],
+        seed=config["seed"],
+        # the new methods' own code (a plugin's modules live outside src/)
+        plugins=method_sources(COMPARE_METHODS),
+        code=code_digest("workflow/scripts/frontier_compare_run.py", []),
+    script:
+        "../scripts/frontier_compare_run.py"
+
+
+rule frontier_compare:
+    """The comparison report: every new method paired with NBO and each family's tuned member at each budget of the published reference, with CIs and verdicts by the preregistered margin, and the figure."""
+    input:
+        runs=expand("results/compare/runs/{model}.csv", model=CONFIRM_MODELS),
+        reference=[
+            f"{REFERENCE_DIR}/frontier_confirm_runs.parquet",
+            f"{REFERENCE_DIR}/frontier_confirm.json",
+        ],
+    output:
+        report="results/compare/report.md",
+        table="results/compare/paired.csv",
+        figure="results/compare/frontier.png",
+    log:
+        "results/logs/frontier_compare.log",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        reference=REFERENCE_DIR,
+        plugins=method_sources(COMPARE_METHODS),
+        code=code_digest("workflow/scripts/frontier_compare.py"),
+    script:
+        "../scripts/frontier_compare.py"
+
+
+rule compare:
+    """Target: the comparison of config plugin_methods with the published reference (make compare PLUGIN_METHODS=...)."""
+    input:
+        rules.frontier_compare.output if COMPARE_METHODS else [],
