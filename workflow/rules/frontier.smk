@@ -542,7 +542,7 @@ rule frontier_compare_run:
         seed=config["seed"],
         # the new methods' own code (a plugin's modules live outside src/)
         plugins=method_sources(COMPARE_METHODS),
-        code=code_digest("workflow/scripts/frontier_compare_run.py", []),
+        code=code_digest("workflow/scripts/frontier_compare_run.py"),
     script:
         "../scripts/frontier_compare_run.py"
 

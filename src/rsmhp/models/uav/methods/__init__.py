@@ -3,8 +3,14 @@ registered with :func:`register` (see :mod:`rsmhp.models.uav.methods.base` for t
 
 Every module of this package is imported when the package is, so a new family is one new
 module here (plus its config entry); a family defined elsewhere (e.g. in a test) registers by
-decorating its class with :func:`register`. The pipeline reaches methods only through this
-registry:
+decorating its class with :func:`register`. An installed package adds families through the
+entry-point group :data:`PLUGIN_GROUP` (``rsmhp.methods``): each entry point names a module
+that registers its families with :func:`register`, or a :class:`Method` subclass to register;
+all are loaded after the built-in families (:func:`plugins` lists them). A plugin family must
+default to no member, so installing a plugin changes no existing run; a family or config key
+that is taken is refused naming both packages, and a plugin that fails to load raises
+:class:`PluginError` naming its entry point and distribution. The pipeline reaches methods only
+through this registry:
 
 * :func:`from_config` builds the members of a ``methods`` config block, in table order;
 * :func:`from_name` / :func:`from_spec` rebuild a member from its name or its rule params;
@@ -17,8 +23,11 @@ registry:
 from __future__ import annotations
 
 import importlib
+import importlib.metadata
 import pkgutil
+import types
 from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
@@ -28,14 +37,19 @@ from rsmhp.models.uav.methods.base import COLUMNS, Hypotheses, Method
 
 __all__ = [
     "COLUMNS",
+    "PLUGIN_GROUP",
     "Hypotheses",
     "Method",
+    "Plugin",
+    "PluginError",
     "baseline",
     "config_problems",
     "families",
     "from_config",
     "from_name",
     "from_spec",
+    "load_plugins",
+    "plugins",
     "register",
     "schema",
     "sort_names",
@@ -44,22 +58,97 @@ __all__ = [
 
 _FAMILIES: dict[str, type[Method]] = {}
 
+#: the entry-point group of method plugins
+PLUGIN_GROUP = "rsmhp.methods"
+
+
+@dataclass(frozen=True)
+class Plugin:
+    """A family registered by an installed plugin: the class, the distribution that installed
+    it (name and version) and its entry point (``name = value``)."""
+
+    family: str
+    config_key: str
+    cls: type[Method]
+    distribution: str
+    version: str | None
+    entry_point: str
+
+
+class PluginError(ImportError):
+    """A method plugin failed to load (the message names its entry point and distribution)."""
+
+
+class _Clash(ValueError):
+    """A family or config key that is already registered."""
+
+
+_PLUGINS: dict[str, Plugin] = {}
+#: the plugins' entry points (a plugin module may be imported before its entry point is
+#: loaded: its classes are attributed by module) and the one being loaded
+_ENTRY_POINTS: list[Any] = []
+_LOADING: list[Any] = []
+
+
+def _plugin_entry_point(cls: type, loading: bool = True) -> Any:
+    """The entry point that brings ``cls``: the one being loaded (``loading``), else the one
+    naming its module; ``None`` for a family of no plugin."""
+    if loading and _LOADING:
+        return _LOADING[-1]
+    mod = cls.__module__
+    named = (e for e in _ENTRY_POINTS if mod == e.module or mod.startswith(e.module + "."))
+    return next(named, None)
+
+
+def _distribution(ep: Any) -> tuple[str, str | None]:
+    """Name and version of the distribution of the entry point ``ep``."""
+    dist = getattr(ep, "dist", None)
+    if dist is None:
+        return f"(unknown distribution of module {ep.module!r})", None
+    return str(dist.name), getattr(dist, "version", None)
+
+
+def _origin(cls: type, new: bool = False) -> str:
+    """Who defined ``cls`` (``new``: the class being registered), for messages: a plugin's
+    distribution and entry point, else the top-level package of its module (``package
+    'rsmhp'``)."""
+    p = _PLUGINS.get(cls.family)
+    if p is not None and p.cls is cls:
+        return f"distribution {p.distribution!r} (entry point {p.entry_point!r})"
+    ep = _plugin_entry_point(cls, loading=new)
+    if ep is not None:
+        return f"distribution {_distribution(ep)[0]!r} (entry point '{ep.name} = {ep.value}')"
+    return f"package {cls.__module__.partition('.')[0]!r}"
+
 
 def register(cls: type[Method]) -> type[Method]:
     """Class decorator: add the family ``cls`` to the registry. Refuses a family or config
-    key that is already registered (by another class) and a second baseline."""
+    key that is already registered (by another class, naming the packages of both), a second
+    baseline, and a plugin family whose ``default`` configures members."""
     if not (isinstance(cls, type) and issubclass(cls, Method)):
         raise TypeError(f"register expects a Method subclass, got {cls!r}")
     for other in _FAMILIES.values():
         if other is cls or (other.__qualname__ == cls.__qualname__ and other.family == cls.family):
             continue
         if other.family == cls.family or other.config_key == cls.config_key:
-            raise ValueError(
-                f"method family {cls.family!r} (config key {cls.config_key!r}) clashes with "
-                f"the registered {other.__name__} ({other.family!r}, {other.config_key!r})"
+            raise _Clash(
+                f"method family {cls.family!r} (config key {cls.config_key!r}, {cls.__name__}) "
+                f"of {_origin(cls, new=True)} clashes with the registered {other.__name__} "
+                f"({other.family!r}, {other.config_key!r}) of {_origin(other)}"
             )
         if cls.baseline and other.baseline:
             raise ValueError(f"{cls.__name__}: {other.__name__} is already the baseline family")
+    ep = _plugin_entry_point(cls)
+    if ep is not None:
+        if cls.default:
+            raise ValueError(
+                f"method family {cls.family!r} of {_origin(cls, new=True)}: a plugin "
+                f"family's default must configure no member ([] or false), got "
+                f"{cls.default!r}: installing a plugin must change no existing run"
+            )
+        dist, version = _distribution(ep)
+        point = f"{ep.name} = {ep.value}"
+        _PLUGINS[cls.family] = Plugin(cls.family, cls.config_key, cls, dist, version, point)
     _FAMILIES[cls.family] = cls
     return cls
 
@@ -67,6 +156,12 @@ def register(cls: type[Method]) -> type[Method]:
 def unregister(family: str) -> None:
     """Remove a family (for tests that register a toy method)."""
     _FAMILIES.pop(family, None)
+    _PLUGINS.pop(family, None)
+
+
+def plugins() -> list[Plugin]:
+    """The families registered by installed plugins, in table order, with their distribution."""
+    return [_PLUGINS[c.family] for c in families() if c.family in _PLUGINS]
 
 
 def families() -> list[type[Method]]:
@@ -161,10 +256,57 @@ def sort_names(names: Iterable[str]) -> list[str]:
     return sorted(names, key=lambda n: from_name(n).sort_key())
 
 
+def load_plugins(entry_points: Iterable[Any] | None = None) -> list[Plugin]:
+    """Load method plugins: ``entry_points`` (default: the installed entry points of
+    :data:`PLUGIN_GROUP`, by distribution and name); returns :func:`plugins`. A plugin that
+    fails to load raises :class:`PluginError` (a clash: ``ValueError``) and registers nothing."""
+    if entry_points is None:
+        found = importlib.metadata.entry_points(group=PLUGIN_GROUP)
+        entry_points = sorted(found, key=lambda e: (_distribution(e)[0], e.name))
+    entry_points = list(entry_points)
+    _ENTRY_POINTS.extend(e for e in entry_points if e not in _ENTRY_POINTS)
+    for ep in entry_points:
+        _load_plugin(ep)
+    return plugins()
+
+
+def _load_plugin(ep: Any) -> None:
+    dist, version = _distribution(ep)
+    point = f"{ep.name} = {ep.value}"
+    saved = dict(_FAMILIES), dict(_PLUGINS)
+    _LOADING.append(ep)
+    try:
+        obj = ep.load()
+        if isinstance(obj, type) and issubclass(obj, Method):
+            if obj not in _FAMILIES.values():
+                register(obj)
+        elif not isinstance(obj, types.ModuleType):
+            raise TypeError(f"it names {obj!r}, neither a module nor a Method subclass")
+        # a module imported before the registry (it imports the registry) registers its
+        # families when its import resumes
+        initialising = getattr(getattr(obj, "__spec__", None), "_initializing", False)
+        if not initialising and not any(p.entry_point == point for p in _PLUGINS.values()):
+            raise TypeError("it registers no method family (decorate the class with @register)")
+    except Exception as e:
+        for registry, before in zip((_FAMILIES, _PLUGINS), saved, strict=True):
+            registry.clear()
+            registry.update(before)
+        if isinstance(e, _Clash):
+            raise
+        raise PluginError(
+            f"method plugin entry point {point!r} (group {PLUGIN_GROUP!r}) of distribution "
+            f"{dist!r}{' ' + version if version else ''} failed to load: "
+            f"{type(e).__name__}: {e} (fix the plugin, or uninstall it: pip uninstall {dist})"
+        ) from e
+    finally:
+        _LOADING.pop()
+
+
 def _import_families() -> None:
     for info in pkgutil.iter_modules(__path__):
         if info.name != "base":
             importlib.import_module(f"{__name__}.{info.name}")
+    load_plugins()
 
 
 _import_families()
