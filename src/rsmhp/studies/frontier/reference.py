@@ -83,7 +83,7 @@ def method_sources(names: Sequence[str]) -> dict[str, str]:
         cls = type(methods.from_name(name))
         source = Path(inspect.getsourcefile(cls) or "")
         top = cls.__module__.partition(".")[0]
-        dist = ",".join(dists.get(top, [top]))
+        dist = ",".join(sorted(set(dists.get(top, [top]))))
         digest = hashlib.sha256(source.read_bytes()).hexdigest()[:16] if source.is_file() else "?"
         out[name] = f"{dist} {cls.family} {digest}"
     return out
