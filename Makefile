@@ -9,7 +9,7 @@ CORES ?= 2
 BIN := $(VENV)/bin
 STAMP := $(VENV)/.rsmhp-installed
 
-.PHONY: help replicate tune publish verify portability test lint setup clean
+.PHONY: help replicate tune publish verify portability compare test lint setup clean
 
 help:
 	@echo "rsmhp: replication pipeline (RS-MHP vs NBO). Targets:"
@@ -17,6 +17,7 @@ help:
 	@echo "  make tune [ARGS=...]       the protocol's tuning (tuning stream; not in replicate), then"
 	@echo "                             copy results/tune/tuned.yaml to config/tuned.yaml"
 	@echo "  make verify [ARGS=...]     run what is missing, compare every claim with paper/claims.json"
+	@echo "  make compare PLUGIN_METHODS=a,b  new planners paired with the published reference (docs/compare.md)"
 	@echo "  make portability [ARGS=...] rerun as on another CPU (numba generic, OpenBLAS Nehalem, no"
 	@echo "                             numpy SIMD) elsewhere; compare with results/ and paper/claims.json"
 	@echo "  make publish               update the tracked paper/ and README results from results/paper/"
@@ -63,6 +64,16 @@ publish: $(STAMP)
 	cp results/paper/figures/*.png paper/figures/
 	$(BIN)/python -m rsmhp.report.readme splice README.md results/paper/glance.md
 	$(BIN)/python -m rsmhp.report.history add results/paper/claims.json --kind implementation
+	mkdir -p paper/reference
+	cp results/frontier/reference/frontier_confirm_runs.parquet results/frontier/reference/frontier_confirm.json paper/reference/
+
+# new planning methods (any registered family, e.g. from a plugin package) on the confirmatory
+# design's scenarios, paired with the published reference paper/reference/ without rerunning
+# it: make compare PLUGIN_METHODS=lhs_nt64 (comma-separated names); docs/compare.md
+comma := ,
+compare: $(STAMP)
+	@test -n "$(PLUGIN_METHODS)" || { echo "make compare: give PLUGIN_METHODS=name[,name...]" >&2; exit 2; }
+	$(BIN)/snakemake -j$(CORES) compare --config 'plugin_methods=[$(subst $(comma),$(comma) ,$(PLUGIN_METHODS))]' $(ARGS)
 
 # compare a run with the committed reference paper/claims.json, claim by claim (runs what is
 # missing first); fails if a verdict flips or a key number leaves its tolerance
@@ -82,8 +93,17 @@ lint: $(STAMP)
 	$(BIN)/snakefmt --check .
 	$(BIN)/snakemake --lint
 
-test: lint
-	$(BIN)/python -m pytest
+# the template method plugin (examples/rsmhp-plugin-example), installed into the venv once: its
+# family is then in the registry, so the conformance tests check it; its own tests run with ours
+PLUGIN := examples/rsmhp-plugin-example
+PLUGIN_STAMP := $(VENV)/.rsmhp-plugin-example-installed
+
+$(PLUGIN_STAMP): $(STAMP) $(PLUGIN)/pyproject.toml
+	$(BIN)/python -m pip install --quiet -e $(PLUGIN)
+	@touch $(PLUGIN_STAMP)
+
+test: lint $(PLUGIN_STAMP)
+	$(BIN)/python -m pytest tests $(PLUGIN)/tests
 
 clean:
 	rm -rf results .snakemake

@@ -38,8 +38,10 @@ Sub-packages
                     pre-flight), protocol (seed streams, planner configurations, tuning rule,
                     preregistration), script (logging and code checks of rule scripts)
   report            ledger (KeyNumber, Claim, Section), verdicts (verdict rules as objects),
-                    statements (the paper's statements and their evidence), render (main text,
-                    appendix, claims, glance table), templates (Jinja2 section templates),
+                    statements (the paper's statements judged on its setups and on variants),
+                    findings (the main claims, "What we found"), power (runs at 80% power),
+                    history (earlier verdicts, fragility), render (main text, appendix,
+                    glance table), html (the HTML report's landing page), templates (Jinja2),
                     markdown (number formatting, tables), palette (one colour and label per
                     method), figures (theme, save_figure), provenance, readme (``make
                     publish``), verify (``make verify``), portability (``make portability``)
@@ -48,11 +50,12 @@ Sub-packages
                     figures, section (the report section, prose in Markdown templates):
                     lqg (Fig. 3), estimators (the estimator ablation), uav (Figs. 4-5),
                     decisions (LQG and UAV regret, the sensitivity map), frontier (equal
-                    compute: exploratory frontier, tuning, confirmatory run), horizon (long
-                    horizons, LQG and UAV, and the optimiser split), scenarios (the
-                    probability of beating NBO across scenarios)
+                    compute: exploratory frontier, tuning, confirmatory run, the published
+                    reference and the comparison of new planners with it), horizon (long
+                    horizons, LQG and UAV, and the optimiser split), scenarios (the best
+                    method per cell and the probability of beating NBO across scenarios)
   testing           check_method: the conformance check of a planning-method family (run it
-                    first on a new one)
+                    first on a new one, in this repository or a plugin package)
 """
 
 __version__ = "0.1.0"

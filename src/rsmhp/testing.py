@@ -18,18 +18,24 @@ Properties
 ----------
 Class (``[class attributes]``, ``[schema]``, ``[default]``, ``[colour_key]``, ``[registry]``):
 ``family``, ``config_key``, ``family_label`` non-empty strings without spaces (the label may
-have them); ``schema`` a valid JSON Schema (``check_schema``); ``default`` valid against it;
-``colour_key`` a key of :data:`rsmhp.report.palette.METHOD_COLOURS` or a hex colour
-``#rrggbb`` (a family the palette does not know); ``order`` an int;
-``baseline``, ``uses_rng``, ``estimates_cost`` bools; the class registered, and exactly one
-baseline family.
+have them); ``schema`` a valid JSON Schema (``check_schema``); ``default`` valid against it,
+and, for a family of an installed plugin (:func:`rsmhp.models.uav.methods.plugins`), building no
+member (a plugin changes no run it is not configured in); ``colour_key`` a key of
+:data:`rsmhp.report.palette.METHOD_COLOURS` or a hex colour ``#rrggbb`` (a family the palette
+does not know); ``order`` an int; ``baseline``, ``uses_rng``, ``estimates_cost`` bools; the
+class registered, and exactly one baseline family.
 
 Members (``[config]``, ``[names]``, ``[round trip]``, ``[spec]``, ``[columns]``,
-``[job_key]``, ``[presentation]``, ``[registry config]``): the config value is valid against
-the schema, has no cross-field problem and builds them through the family, and through the
-registry (among the other families' defaults), counted by ``methods.count``; names non-empty, of
-``[A-Za-z0-9_.-]`` (rule wildcards and file names), unique, claimed by no other registered
-family; ``from_name(m.name) == m`` and ``from_spec(m.spec()) == m`` (and hashable);
+``[job_key]``, ``[presentation]``, ``[registry config]``, ``[config schema]``): the config
+value is valid against the schema, has no cross-field problem and builds them through the
+family, and through the registry (among the other families' defaults), counted by
+``methods.count``; the config schema's ``methods`` blocks (``$defs/uav_methods`` of
+:func:`rsmhp.pipeline.config.load_schema`: ``uav.methods``, ``decisions.uav.methods``, ...)
+accept ``{config_key: value}``; names non-empty, of ``[A-Za-z0-9_.-]`` (rule wildcards and
+file names), unique, claimed by no other registered family, and the family's ``parse`` gives
+``None`` for other names (it must not raise: :func:`~rsmhp.models.uav.methods.from_name` asks
+every family in turn); ``cls.parse(m.name) == m``, ``from_name(m.name) == m`` and
+``from_spec(m.spec()) == m`` (and hashable);
 ``columns()`` exactly ``N_T``, ``N``, ``M``, integers :math:`\ge 0`; ``job_key()`` a
 JSON-serialisable mapping with ``job_key()["method"] == m.name``, none of the closed loop's
 own keys (``run``, ``step``, ``experiment``), distinct across members and usable by
@@ -50,19 +56,33 @@ hypotheses, without it ``rng=None`` gives the same ones. Independence: the draws
 on the member's own stream: not on numpy's or Python's global random state, nor on draws made
 in between by the other members (no state carried from call to call).
 
-Planning step (``[planner]``, ``[plan]``, ``[plan determinism]``): ``m.planner(setup)`` is a
+Planning step (``[planner]``, ``[plan]``, ``[time per step]``, ``[planner protocol]``,
+``[plan determinism]``, ``[plan independence]``): ``m.planner(setup)`` is a
 :class:`rsmhp.models.uav.planner.Planner`; ``plan(belief, zeros (H, 2), rng)`` (``rng=None``
-without ``uses_rng``) returns a :class:`~rsmhp.models.uav.planner.PlanResult` with controls
-(H, 2) finite and within :math:`\pm` ``uav.control_scale``; ``uav_path`` (H, 4) the
-kinematic rollout of those controls; a finite ``cost``; ``cost_warm`` a float; ``nit``,
-``n_kernel_calls`` ints :math:`\ge 0`; ``work`` (machine-independent compute of the step,
-model steps) an int :math:`> 0`; ``diagnostics`` a mapping of names to floats;
-``converged`` ``None`` or a bool; ``hypotheses`` ``None`` or valid hypotheses of horizon H
-(those of :meth:`~rsmhp.models.uav.methods.Method.hypotheses` for the same stream when the
-family keeps the default planner). The wall time of the step is measured
-(:attr:`CheckReport.plan_seconds`, what the closed loop sums into ``plan_seconds``). The
-same planner planning again with the same seed (and other global random state) gives the
-identical result; the belief and warm start are not modified.
+without ``uses_rng``, as the closed loop calls it) returns a
+:class:`~rsmhp.models.uav.planner.PlanResult` with controls (H, 2) finite and within
+:math:`\pm` ``uav.control_scale``; ``uav_path`` (H, 4) the kinematic rollout of those
+controls; a finite ``cost``; ``cost_warm`` a float; ``nit``, ``n_kernel_calls`` ints
+:math:`\ge 0`; ``diagnostics`` a mapping of names to floats; ``converged`` ``None`` or a
+bool; ``hypotheses`` ``None`` or valid hypotheses of horizon H. Time per step: the step's wall
+time (what the closed loop sums into ``plan_seconds``; :attr:`CheckReport.plan_seconds`) is
+positive and finite, and the step reports its compute: ``work`` (machine-independent, in model
+steps; the closed loop's ``work_per_step``, the frontier study's budget axis) an int
+:math:`> 0` that fits an int64, and at least one cost evaluation (T H model steps) when the
+plan has T hypotheses (:attr:`CheckReport.plan_work`). The planner protocol: a family with a
+cost estimate (``estimates_cost``, the default) returns the hypotheses it planned over, those
+of :meth:`~rsmhp.models.uav.methods.Method.hypotheses` for the same stream (the decision study
+scores its own cost of other plans with them); a family without (``estimates_cost`` False, a
+tree search planning over simulated beliefs) overrides
+:meth:`~rsmhp.models.uav.methods.Method.planner` (the default plans over hypotheses), returns
+``hypotheses=None`` and its :meth:`~rsmhp.models.uav.methods.Method.hypotheses` raises
+``NotImplementedError`` (no study asks it for any); with ``uses_rng`` the plan depends on the
+stream (another seed gives another result), without it planning with a stream (the decision
+study passes one to every member) gives the same result as with ``None``. Determinism and
+independence: the same planner planning again with the same seed (and other global random
+state) gives the identical result; so does a fresh planner of an equal fresh member
+(``from_spec``) after the other members and the baseline have planned; the belief and warm
+start are not modified.
 """
 
 from __future__ import annotations
@@ -109,12 +129,14 @@ _HEX = re.compile(r"#[0-9a-fA-F]{6}")
 @dataclass(frozen=True)
 class CheckReport:
     """What :func:`check_method` checked: the family, its members' names, the properties (in
-    the order checked) and the wall time (s) of each member's planning step."""
+    the order checked), the wall time (s) of each member's planning step and its reported
+    compute (``PlanResult.work``, model steps)."""
 
     family: str
     members: tuple[str, ...]
     checks: tuple[str, ...]
     plan_seconds: dict[str, float] = field(default_factory=dict)
+    plan_work: dict[str, int] = field(default_factory=dict)
 
 
 def example_setup(horizon: int = HORIZON) -> UAVSetup:
@@ -232,11 +254,13 @@ def check_method(
     if value is not None:
         _check_registry_config(c, cls, built, value)
     seconds: dict[str, float] = {}
+    work: dict[str, int] = {}
     for m in built:
         if cls.estimates_cost:
             _check_hypotheses(c, m, built, setup, belief)
-        seconds[m.name] = _check_plan(c, m, setup, belief)
-    return CheckReport(cls.family, tuple(m.name for m in built), tuple(c.done), seconds)
+        seconds[m.name], work[m.name] = _check_plan(c, m, built, setup, belief)
+    names = tuple(m.name for m in built)
+    return CheckReport(cls.family, names, tuple(c.done), seconds, work)
 
 
 # ------------------------------------------------------------------------------ class
@@ -296,6 +320,16 @@ def _check_class(c: _Checker, cls: type[Method]) -> None:
             f"{cls.default!r} is not valid against the schema: "
             + "; ".join(e.message for e in errors),
         )
+        plugin = next((p for p in registry.plugins() if p.cls is cls), None)
+        if plugin is not None:
+            n = len(cls.from_config(cls.default, f"methods.{cls.config_key}"))
+            c.that(
+                n == 0,
+                "default",
+                f"a plugin family (distribution {plugin.distribution!r}) must configure no "
+                f"member by default (installing it must change no existing run), but "
+                f"{cls.default!r} builds {n}",
+            )
     with c.step("colour_key"):
         key = getattr(cls, "colour_key", None)
         c.that(
@@ -395,6 +429,37 @@ def _check_registry_config(c: _Checker, cls: type[Method], built: list[Method], 
             f"methods.count counts {n + n_default} members of {value!r}, "
             f"from_config builds {len(built)}",
         )
+    with c.step("config schema"):
+        schema = _methods_block_schema()
+        block = schema["$defs"]["uav_methods"]
+        c.that(
+            cls.config_key in block.get("properties", {}),
+            "config schema",
+            f"the config schema's methods blocks ($defs/uav_methods) have no key "
+            f"{cls.config_key!r} (rsmhp.pipeline.config.load_schema inserts "
+            "rsmhp.models.uav.methods.schema())",
+        )
+        errors = list(_validator(schema)(schema).iter_errors({cls.config_key: value}))
+        c.that(
+            not errors,
+            "config schema",
+            f"the config schema's methods blocks refuse {{{cls.config_key!r}: {value!r}}}: "
+            + "; ".join(e.message for e in errors),
+        )
+
+
+def _methods_block_schema() -> dict[str, Any]:
+    """A schema of one ``methods`` block of the config (``uav.methods`` and the others): the
+    config schema's ``$defs/uav_methods`` with the registry's families, as
+    :func:`rsmhp.pipeline.config.load_schema` builds it (outside a checkout, without the
+    schema file: the registry's part alone)."""
+    from rsmhp.pipeline import config
+
+    if config.SCHEMA_PATH.is_file():
+        defs = config.load_schema()["$defs"]
+    else:
+        defs = config.with_methods({"$defs": {"uav_methods": {"type": "object"}}})["$defs"]
+    return {"$ref": "#/$defs/uav_methods", "$defs": defs}
 
 
 def _example_value(cls: type[Method], uav: Mapping[str, Any]) -> Any:
@@ -479,10 +544,26 @@ def _check_members(c: _Checker, cls: type[Method], built: list[Method]) -> None:
                 )
     dup = sorted({n for n in names if names.count(n) > 1})
     c.that(not dup, "names", f"names {dup} are not unique across the members")
+    with c.step("names"):
+        foreign = ("", "x", "nbo", "rsmhp_nt4", "tree_n8_m100", "dpw_s8", "lhs_nt4")
+        for n in (*foreign, *(f"{name}_x" for name in names), *(f"x{name}" for name in names)):
+            if n in names:
+                continue
+            try:
+                got = cls.parse(n)
+            except Exception as e:
+                c.fail("names", f"parse({n!r}) raised {type(e).__name__}: {e} (must be None)")
+            c.that(
+                got is None or _safe_name(got) == n,
+                "names",
+                f"parse({n!r}) must be None (not a name of the family), got {got!r}",
+            )
     keys: dict[str, str] = {}
     for m in built:
         with c.step("round trip", m):
             c.that(hash(m) == hash(m), "round trip", "not hashable", m)
+            own = cls.parse(m.name)
+            c.that(own == m, "round trip", f"{cls.__name__}.parse(name) gives {own!r}", m)
             back = registry.from_name(m.name)
             c.that(back == m, "round trip", f"from_name(name) gives {back!r}, not {m!r}", m)
             spec = m.spec()
@@ -726,10 +807,49 @@ def _check_hypotheses(
 # ---------------------------------------------------------------------------- planning
 
 
-def _check_plan(c: _Checker, m: Method, setup: UAVSetup, belief: Belief) -> float:
+def _plan(m: Method, setup: UAVSetup, belief: Belief, seed: int = SEED, planner: Any = None):
+    """One planning step of ``m`` as the closed loop makes it (its stream, or ``None``)."""
+    planner = m.planner(setup) if planner is None else planner
+    H = setup.planner.horizon
+    return planner.plan(belief, np.zeros((H, 2)), _stream(m, seed) if m.uses_rng else None)
+
+
+#: the fields of a PlanResult compared by the determinism checks
+_PLAN_FIELDS = ("controls", "cost", "cost_warm", "nit", "n_kernel_calls", "work", "uav_path")
+
+
+def _plan_diffs(a: PlanResult, b: PlanResult) -> list[str]:
+    """The fields in which two plans differ (NaN equals NaN)."""
+    out = []
+    for f in _PLAN_FIELDS:
+        x, y = np.asarray(getattr(a, f)), np.asarray(getattr(b, f))
+        if not (x.shape == y.shape and np.array_equal(x, y, equal_nan=x.dtype.kind == "f")):
+            out.append(f)
+    da, db = dict(a.diagnostics), dict(b.diagnostics)
+    if set(da) != set(db) or any(
+        not np.array_equal(da[k], db[k], equal_nan=isinstance(da[k], float | np.floating))
+        for k in da
+    ):
+        out.append("diagnostics")
+    ha, hb = a.hypotheses, b.hypotheses
+    if (ha is None) != (hb is None) or (ha is not None and not _same_hypotheses(ha, hb)):
+        out.append("hypotheses")
+    return out
+
+
+def _check_plan(
+    c: _Checker, m: Method, built: list[Method], setup: UAVSetup, belief: Belief
+) -> tuple[float, int]:
     H = setup.planner.horizon
     uses = m.uses_rng
     with c.step("planner", m):
+        c.that(
+            m.estimates_cost or type(m).planner is not Method.planner,
+            "planner protocol",
+            "a family without a cost estimate (estimates_cost False) must override "
+            "Method.planner (the default plans over hypotheses())",
+            m,
+        )
         planner = m.planner(setup)
         c.that(
             isinstance(planner, Planner),
@@ -755,21 +875,121 @@ def _check_plan(c: _Checker, m: Method, setup: UAVSetup, belief: Belief) -> floa
                 "the default planner did not plan over the member's hypotheses of its stream",
                 m,
             )
+    with c.step("time per step", m):
+        c.that(
+            math.isfinite(seconds) and seconds > 0,
+            "time per step",
+            f"the planning step's wall time must be positive and finite, got {seconds!r} s",
+            m,
+        )
+        work = res.work
+        c.that(
+            0 < work < 2**63,
+            "time per step",
+            f"work (the step's compute in model steps, the closed loop's work_per_step) must be "
+            f"reported: an int in [1, 2**63), got {work!r}",
+            m,
+        )
+        if res.hypotheses is not None:
+            T = int(np.shape(res.hypotheses.states)[0])
+            c.that(
+                work >= T * H,
+                "time per step",
+                f"work {work} is less than one cost evaluation of its {T} hypotheses over "
+                f"{H} steps ({T * H} model steps)",
+                m,
+            )
+    with c.step("planner protocol", m):
+        _check_protocol(c, m, res, setup, belief)
     with c.step("plan determinism", m):
         with _global_random_state(2):
             again = planner.plan(belief, np.zeros((H, 2)), _stream(m) if uses else None)
-        diffs = [
-            f
-            for f in ("controls", "cost", "nit", "n_kernel_calls", "work", "uav_path")
-            if not np.array_equal(getattr(res, f), getattr(again, f))
-        ]
+        diffs = _plan_diffs(res, again)
         c.that(
             not diffs,
             "plan determinism",
             f"planning again with the same stream (and other global random state) changed {diffs}",
             m,
         )
-    return seconds
+    with c.step("plan independence", m):
+        # a fresh planner of an equal fresh member, after the others (and the baseline) planned
+        with _global_random_state(3):
+            fresh = registry.from_spec(m.spec())
+            fresh_planner = fresh.planner(setup)
+            for o in [*(o for o in built if o != m), registry.baseline()()]:
+                _plan(o, setup, belief)
+            diffs = _plan_diffs(res, _plan(fresh, setup, belief, planner=fresh_planner))
+        c.that(
+            not diffs,
+            "plan independence",
+            f"a fresh planner of an equal member, planning with the same stream after the other "
+            f"members planned, changed {diffs} (state shared between planners or members)",
+            m,
+        )
+    return seconds, int(work)
+
+
+def _check_protocol(c: _Checker, m: Method, res: PlanResult, setup: UAVSetup, belief: Belief):
+    """The planner protocol of the module docstring: hypotheses or none, and the stream."""
+    prop = "planner protocol"
+    if m.estimates_cost:
+        c.that(
+            res.hypotheses is not None,
+            prop,
+            "a family with a cost estimate (estimates_cost True) must return the hypotheses it "
+            "planned over (PlanResult.hypotheses; the decision study scores its own cost of "
+            "other plans with them), got None",
+            m,
+        )
+        own = m.hypotheses(belief, setup, _stream(m) if m.uses_rng else None)
+        c.that(
+            _same_hypotheses(res.hypotheses, own),
+            prop,
+            "the plan's hypotheses are not the member's hypotheses() of the same stream (the "
+            "studies take either for the member's cost estimate)",
+            m,
+        )
+    else:
+        c.that(
+            res.hypotheses is None,
+            prop,
+            "a family without a cost estimate (estimates_cost False) must plan with "
+            "hypotheses=None (the decision study would take them for its cost of any plan), "
+            f"got {type(res.hypotheses).__name__}",
+            m,
+        )
+        try:
+            m.hypotheses(belief, setup, _stream(m))
+        except NotImplementedError:
+            pass
+        else:
+            c.fail(
+                prop,
+                "a family without a cost estimate (estimates_cost False) has no hypotheses: "
+                "hypotheses() must raise NotImplementedError (set estimates_cost True if the "
+                "hypotheses are its cost estimate)",
+                m,
+            )
+    if m.uses_rng:
+        other = _plan(m, setup, belief, SEED + 1)
+        c.that(
+            bool(_plan_diffs(res, other)),
+            prop,
+            "uses_rng is True but planning with another stream seed gives the identical plan "
+            "(set uses_rng False for a deterministic method)",
+            m,
+        )
+    else:
+        H = setup.planner.horizon
+        streamed = m.planner(setup).plan(belief, np.zeros((H, 2)), _stream(m))
+        diffs = _plan_diffs(res, streamed)
+        c.that(
+            not diffs,
+            prop,
+            f"uses_rng is False but planning with a stream instead of None changed {diffs} "
+            "(the decision study passes every member a stream)",
+            m,
+        )
 
 
 def _validate_plan(c: _Checker, m: Method, res: Any, setup: UAVSetup, belief: Belief) -> None:
@@ -821,12 +1041,6 @@ def _validate_plan(c: _Checker, m: Method, res: Any, setup: UAVSetup, belief: Be
             f"{f} must be an int >= 0, got {v!r}",
             m,
         )
-    c.that(
-        res.work > 0,
-        prop,
-        "work (the step's compute in model steps) must be reported (> 0), got 0",
-        m,
-    )
     c.that(
         res.converged is None or isinstance(res.converged, bool | np.bool_),
         prop,

@@ -1,13 +1,21 @@
 """The conformance check of UAV planning-method families (rsmhp.testing.check_method).
 
 * every registered family passes it, with its default members (derived from its schema) and
-  with members configured by value or given directly;
+  with members configured by value or given directly; the registry's families include those of
+  installed plugins (entry points ``rsmhp.methods``, e.g. ``examples/rsmhp-plugin-example``),
+  so an installed plugin's family is checked here too;
 * it refuses faulty families, each with a message naming the family and the property: a
   toy family that passes is broken in one place at a time (weights that miss one by 1e-10,
   an unknown colour key or a malformed hex colour, an invalid schema or default, a name of
   another family, a job key without the name, a missing column, hypotheses that read the
   global random state, ignore the stream or are not made by their noise, controls out of
-  bounds, a planner that keeps state between plans, an unregistered class);
+  bounds, a planner that keeps state between plans, a step that reports no work or less than
+  one cost evaluation, a planner that drops or swaps its hypotheses, a parse that raises on
+  another family's name, an unregistered class);
+* the planner protocol of a family without hypotheses (``estimates_cost`` False, as the tree
+  search): a toy random-shooting planner conforms, and breaking it in one place is refused
+  (hypotheses returned, hypotheses() answering, the default planner kept, the stream ignored,
+  a planner seeded from a counter shared between planners);
 * the toy families are registered only for the test that uses them: the registry is the
   same before and after.
 """
@@ -20,10 +28,11 @@ from typing import Any, ClassVar
 import numpy as np
 import pytest
 
-from rsmhp.models.uav import methods, target
-from rsmhp.models.uav.methods import Hypotheses
+from rsmhp.models.uav import kinematics, methods, target
+from rsmhp.models.uav.methods import Hypotheses, Method
 from rsmhp.models.uav.methods.monte_carlo import MonteCarlo
 from rsmhp.models.uav.methods.tree_search import TreeSearch
+from rsmhp.models.uav.planner import PlanResult
 from rsmhp.testing import CheckReport, check_method, example_setup
 
 
@@ -33,7 +42,19 @@ def test_every_registered_family_conforms(family):
     assert isinstance(report, CheckReport) and report.family == family.family
     assert report.members and set(report.plan_seconds) == set(report.members)
     assert all(s > 0 for s in report.plan_seconds.values())
-    expected = {"class attributes", "round trip", "job_key", "plan", "plan determinism"}
+    assert set(report.plan_work) == set(report.members)
+    assert all(w > 0 for w in report.plan_work.values())
+    expected = {
+        "class attributes",
+        "round trip",
+        "job_key",
+        "config schema",
+        "plan",
+        "time per step",
+        "planner protocol",
+        "plan determinism",
+        "plan independence",
+    }
     if family.estimates_cost:
         expected |= {"hypotheses", "determinism", "stream independence"}
     assert expected <= set(report.checks)
@@ -188,6 +209,53 @@ class Stateful(Toy):
         return _Counting(super().planner(setup))
 
 
+class _Edited:
+    """A planner whose results are edited by ``edit(result)``."""
+
+    def __init__(self, inner, edit) -> None:
+        self.inner, self.edit = inner, edit
+
+    def plan(self, belief, warm_start, rng):
+        res = self.inner.plan(belief, warm_start, rng)
+        self.edit(res)
+        return res
+
+
+class NoWork(Toy):
+    def planner(self, setup):
+        return _Edited(super().planner(setup), lambda r: setattr(r, "work", 0))
+
+
+class TooLittleWork(Toy):
+    def planner(self, setup):
+        return _Edited(super().planner(setup), lambda r: setattr(r, "work", 1))
+
+
+class DropsHypotheses(Toy):
+    def planner(self, setup):
+        return _Edited(super().planner(setup), lambda r: setattr(r, "hypotheses", None))
+
+
+class SwapsHypotheses(Toy):
+    """Plans over the hypotheses of another stream than its hypotheses() of the step's."""
+
+    def planner(self, setup):
+        def draw(belief, rng):
+            return self.hypotheses(belief, setup, np.random.default_rng(rng.integers(2**32)))
+
+        from rsmhp.models.uav.planner import SampledCostPlanner
+
+        return SampledCostPlanner(draw, setup.uav, setup.target, setup.sensor, setup.planner)
+
+
+class RaisingParse(Toy):
+    @classmethod
+    def parse(cls, name):
+        if not name.startswith("toy_nt"):
+            raise ValueError(f"not a toy name: {name!r}")
+        return super().parse(name)
+
+
 FAULTS = [
     (BadWeights, r"\[weights\] weights sum to one: sum is 1\.0000000001"),
     (UnknownColour, r"\[colour_key\] 'no_such_colour' is neither a key of .*METHOD_COLOURS"),
@@ -203,6 +271,11 @@ FAULTS = [
     (NoiseMismatch, r"\[hypotheses\] noise does not reproduce the states"),
     (OutOfBounds, r"\[plan\] controls leave the bounds"),
     (Stateful, r"\[plan determinism\] planning again .* changed \['cost'\]"),
+    (NoWork, r"\[time per step\] work .* must be reported: an int in \[1, 2\*\*63\), got 0"),
+    (TooLittleWork, r"\[time per step\] work 1 is less than one cost evaluation of its 4"),
+    (DropsHypotheses, r"\[planner protocol\] a family with a cost estimate .* got None"),
+    (SwapsHypotheses, r"\[planner protocol\] the plan's hypotheses are not the member's"),
+    (RaisingParse, r"\[names\] parse\(''\) raised ValueError"),
 ]
 
 
@@ -244,3 +317,145 @@ def test_an_unregistered_family_is_refused():
         check_method(Toy)
     with pytest.raises(AssertionError, match=r"\[class attributes\] expected a subclass"):
         check_method(dict)
+
+
+# ------------------------------------------------ the protocol of a planner without hypotheses
+
+
+class _Shooting:
+    """Random shooting: ``n`` control sequences uniform in the box drawn from the step's
+    stream, the one ending nearest the nominal target wins; no hypotheses (a planner of the
+    tree search's kind). ``cost``: that distance (m); ``work``: n H model steps."""
+
+    def __init__(self, n, setup, hypotheses=False) -> None:
+        self.n, self.setup, self.hypotheses = n, setup, hypotheses
+
+    def plan(self, belief, warm_start, rng):
+        H, uav = self.setup.planner.horizon, self.setup.uav
+        scale = np.asarray(uav.control_scale, dtype=float)
+        u = rng.uniform(-1.0, 1.0, (self.n, H, 2)) * scale
+        paths = kinematics.rollout(np.asarray(belief.uav, dtype=float), u, uav)
+        goal = target.nominal(belief.x_hat, H, self.setup.target)[0, -1, :2]
+        dist = np.linalg.norm(paths[:, -1, :2] - goal, axis=1)
+        best = int(np.argmin(dist))
+        hyp = None
+        if self.hypotheses:
+            hyp = Hypotheses.equal(target.nominal(belief.x_hat, H, self.setup.target))
+        return PlanResult(
+            controls=u[best],
+            cost=float(dist[best]),
+            cost_warm=float("nan"),
+            nit=self.n,
+            n_kernel_calls=0,
+            uav_path=paths[best],
+            hypotheses=hyp,
+            diagnostics={"best": float(best)},
+            work=self.n * H,
+        )
+
+
+@dataclass(frozen=True)
+class Shooting(Method):
+    """A conforming toy family without a cost estimate (``estimates_cost`` False)."""
+
+    n: int
+
+    family: ClassVar[str] = "toyshoot"
+    config_key: ClassVar[str] = "toyshoot"
+    schema: ClassVar[dict[str, Any]] = {
+        "type": "array",
+        "items": {"type": "integer", "minimum": 1, "maximum": 1000},
+    }
+    default: ClassVar[Any] = []
+    family_label: ClassVar[str] = "shooting"
+    colour_key: ClassVar[str] = "#7a5195"
+    order: ClassVar[int] = 91
+    name_pattern: ClassVar[str] = r"toyshoot_n(\d+)"
+    n_traj: ClassVar[int] = 0
+    estimates_cost: ClassVar[bool] = False
+
+    @classmethod
+    def from_config(cls, value, path):
+        return [cls(int(n)) for n in value]
+
+    @property
+    def name(self) -> str:
+        return f"toyshoot_n{self.n}"
+
+    def job_key(self) -> dict[str, Any]:
+        return {"method": self.name, "N_T": 0, "N": None, "M": None}
+
+    def hypotheses(self, belief, setup, rng) -> Hypotheses:
+        raise NotImplementedError("random shooting plans without hypotheses")
+
+    def planner(self, setup):
+        return _Shooting(self.n, setup)
+
+
+class ShootingWithHypotheses(Shooting):
+    def planner(self, setup):
+        return _Shooting(self.n, setup, hypotheses=True)
+
+
+class ShootingAnswersHypotheses(Shooting):
+    def hypotheses(self, belief, setup, rng) -> Hypotheses:
+        return Hypotheses.equal(target.nominal(belief.x_hat, setup.planner.horizon, setup.target))
+
+
+class ShootingDefaultPlanner(Shooting):
+    planner = Method.planner
+
+
+class ShootingIgnoresStream(Shooting):
+    def planner(self, setup):
+        inner = _Shooting(self.n, setup)
+
+        class Fixed:
+            def plan(self, belief, warm_start, rng):
+                return inner.plan(belief, warm_start, np.random.default_rng(0))
+
+        return Fixed()
+
+
+class _Numbered(_Shooting):
+    """Seeded at construction from a counter shared by every planner (state across planners)."""
+
+    made = 0
+
+    def __init__(self, n, setup) -> None:
+        super().__init__(n, setup)
+        _Numbered.made += 1
+        self.number = _Numbered.made
+
+    def plan(self, belief, warm_start, rng):
+        res = super().plan(belief, warm_start, rng)
+        res.cost += 1e-9 * self.number
+        return res
+
+
+class ShootingSharedCounter(Shooting):
+    def planner(self, setup):
+        return _Numbered(self.n, setup)
+
+
+SEARCH_FAULTS = [
+    (ShootingWithHypotheses, r"must plan with hypotheses=None .* got Hypotheses"),
+    (ShootingAnswersHypotheses, r"hypotheses\(\) must raise NotImplementedError"),
+    (ShootingDefaultPlanner, r"must override Method\.planner"),
+    (ShootingIgnoresStream, r"uses_rng is True but planning with another stream seed gives"),
+    (ShootingSharedCounter, r"\[plan independence\] a fresh planner .* changed \['cost'\]"),
+]
+
+
+def test_a_planner_without_hypotheses_conforms(local_registry):
+    report = check_method(local_registry(Shooting))
+    assert report.members == ("toyshoot_n4", "toyshoot_n8")
+    assert report.plan_work == {"toyshoot_n4": 4 * 4, "toyshoot_n8": 8 * 4}
+    assert "hypotheses" not in report.checks and "planner protocol" in report.checks
+
+
+@pytest.mark.parametrize("cls,message", SEARCH_FAULTS, ids=[c.__name__ for c, _ in SEARCH_FAULTS])
+def test_the_protocol_without_hypotheses_is_enforced(local_registry, cls, message):
+    local_registry(cls)
+    with pytest.raises(AssertionError, match=rf"'{cls.__name__}' \(family 'toyshoot'\).*{message}"):
+        check_method(cls)

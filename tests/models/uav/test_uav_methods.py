@@ -116,7 +116,8 @@ def _all_blocks():
 
 
 def test_families_and_the_published_job_keys():
-    assert [c.family for c in methods.families()] == [
+    # this repository's families (an installed plugin package, e.g. the example, adds its own)
+    assert [c.family for c in methods.families() if c.__module__.startswith("rsmhp.")] == [
         "nbo",
         "rsmhp",
         "rsmhp_per_step",

@@ -128,7 +128,9 @@ def register(cls: type[Method]) -> type[Method]:
     if not (isinstance(cls, type) and issubclass(cls, Method)):
         raise TypeError(f"register expects a Method subclass, got {cls!r}")
     for other in _FAMILIES.values():
-        if other is cls or (other.__qualname__ == cls.__qualname__ and other.family == cls.family):
+        # the same class again (its module imported or run again) replaces itself
+        same = (other.__module__, other.__qualname__) == (cls.__module__, cls.__qualname__)
+        if other is cls or (same and other.family == cls.family):
             continue
         if other.family == cls.family or other.config_key == cls.config_key:
             raise _Clash(
