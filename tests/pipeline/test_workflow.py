@@ -824,3 +824,39 @@ def test_provenance_records_the_code_of_every_rule(run_j2):
     assert runs[1].endswith(f",uav_collect:{rules['uav_collect']['current']}")
     appendix = (run_j2 / "results/paper/appendix.md").read_text()
     assert f"lqg_convergence {rules['lqg_convergence']['current']}" in appendix
+
+
+def test_compare_pairs_a_new_method_with_the_reference_and_refuses_other_scenarios(
+    run_j2, tmp_path
+):
+    """`snakemake compare`: a method the confirmatory run did not run is run on its scenarios
+    and paired with every reference configuration read from paper/reference/ (not rerun:
+    no confirmatory job runs); a workflow whose scenarios differ from the reference's is
+    refused before any job, naming what differs, and writes nothing."""
+    wd = tmp_path / "wd"
+    shutil.copytree(run_j2, wd, symlinks=True)
+    shutil.copytree(wd / "results/frontier/reference", wd / "paper/reference")
+    meta = json.loads((wd / "paper/reference/frontier_confirm.json").read_text())
+    assert meta["scenario"]["config"]["seed"] == 7 and meta["rows"] > 0
+    res = snakemake(wd, "-j1", "compare", "--config", "plugin_methods=[rsmhp_nt4]")
+    assert res.returncode == 0, res.stderr[-3000:]
+    ran = re.findall(r"^rule (\w+):", res.stdout + res.stderr, flags=re.M)
+    assert set(ran) == {"frontier_compare_run", "frontier_compare", "compare"}, ran
+    table = pd.read_csv(wd / "results/compare/paired.csv")
+    reference = pd.read_parquet(wd / "paper/reference/frontier_confirm_runs.parquet")
+    assert set(table["config"]) == set(reference["config"])  # NBO and every tuned member
+    assert set(table["verdict"]) <= {"better", "worse", "equivalent", "inconclusive"}
+    runs = pd.read_csv(wd / "results/compare/runs/fp150.csv")
+    assert sorted(runs["run"]) == sorted(reference.loc[reference.config == "nbo", "run"])
+    report = (wd / "results/compare/report.md").read_text()
+    assert "## rsmhp_nt4 on 'fp150'" in report and "not rerun" in report
+    assert (wd / "results/compare/frontier.png").stat().st_size > 10_000
+    # another seed: other scenarios, so nothing would pair: refused before any job
+    before = (wd / "results/compare/paired.csv").read_bytes()
+    res = snakemake(wd, "-j1", "compare", "--config", "plugin_methods=[rsmhp_nt4]", "seed=8")
+    assert res.returncode != 0
+    assert "config seed (reference 7, this workflow 8)" in res.stderr
+    assert "Traceback" not in res.stderr and "rule frontier_compare_run" not in res.stdout
+    assert (wd / "results/compare/paired.csv").read_bytes() == before
+    res = snakemake(wd, "-j1", "compare", "--config", "plugin_methods=[nosuch_nt4]")
+    assert res.returncode != 0 and "belongs to no registered family" in res.stderr
