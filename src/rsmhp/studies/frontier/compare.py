@@ -28,6 +28,7 @@ from typing import Any
 import matplotlib.pyplot as plt
 import numpy as np
 import pandas as pd
+from matplotlib.ticker import NullFormatter, ScalarFormatter
 
 from rsmhp.core.stats import mean_ci
 from rsmhp.report.markdown import fmt, fmt_ci, markdown_table
@@ -192,6 +193,8 @@ def compare_figure(
             ax.scatter(x, y, marker="*", s=180, color="crimson", edgecolor="k", zorder=4,
                        label=f"{method} (new)")  # fmt: skip
         ax.set_xscale("log")
+        ax.xaxis.set_major_formatter(ScalarFormatter())
+        ax.xaxis.set_minor_formatter(NullFormatter())
         ax.set_xlabel("planning ms per step (reference: its machine; new: this one)")
         ax.set_ylabel("closed-loop mean location error (m)")
         ax.set_title(f"'{model}'")
