@@ -568,7 +568,6 @@ rule frontier_compare:
         mem_mb=1000,
         runtime=5,
     params:
-        reference=REFERENCE_DIR,
         plugins=method_sources(COMPARE_METHODS),
         code=code_digest("workflow/scripts/frontier_compare.py"),
     script:

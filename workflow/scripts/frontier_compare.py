@@ -1,6 +1,8 @@
 """Rule frontier_compare: the new methods paired with the published reference (report,
 table, figure; rsmhp.studies.frontier.compare)."""
 
+from pathlib import Path
+
 import pandas as pd
 
 from rsmhp.pipeline.io import write_csv, write_text
@@ -10,7 +12,7 @@ from rsmhp.studies.frontier.compare import compare_figure, compare_markdown, pai
 from rsmhp.studies.frontier.reference import load_reference
 
 with rule_logging(snakemake) as log:
-    reference, meta = load_reference(snakemake.params.reference)
+    reference, meta = load_reference(Path(snakemake.input.reference[0]).parent)
     new = pd.concat([pd.read_csv(f) for f in snakemake.input.runs], ignore_index=True)
     margin = float(meta["preregistration"]["margin_m"])
     table = paired_comparison(new, reference, meta["ladder"], margin)
