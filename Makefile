@@ -56,8 +56,13 @@ tune: $(STAMP)
 # copy the report of results/ into the tracked paper/ (the only target that changes tracked files)
 # copy the report, its claims (the reference of make verify) and the README's glance table,
 # and add the run's verdicts to paper/history.csv (the fragility lines of later reports)
+PUBLISHED := results/paper/replication.md results/paper/appendix.md results/paper/claims.json \
+	results/paper/glance.md results/frontier/reference/frontier_confirm_runs.parquet \
+	results/frontier/reference/frontier_confirm.json
+
 publish: $(STAMP)
-	$(BIN)/snakemake -j$(CORES) report $(ARGS)
+	$(BIN)/snakemake -j$(CORES) report frontier_reference $(ARGS)
+	@for f in $(PUBLISHED); do test -f $$f || { echo "make publish: $$f is missing; nothing was copied" >&2; exit 1; }; done
 	rm -rf paper/figures
 	mkdir -p paper/figures
 	cp results/paper/replication.md results/paper/appendix.md results/paper/claims.json paper/

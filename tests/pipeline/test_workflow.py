@@ -843,7 +843,8 @@ def test_compare_pairs_a_new_method_with_the_reference_and_refuses_other_scenari
     from rsmhp.models.uav import methods
 
     new = "lhs_nt4" if "lhs" in {c.family for c in methods.families()} else "rsmhp_nt4"
-    res = snakemake(wd, "-j1", "compare", "--config", f"plugin_methods=[{new}]")
+    # NBO, run again through compare, is its own reference: every paired difference is 0
+    res = snakemake(wd, "-j1", "compare", "--config", f"plugin_methods=[{new}, nbo]")
     assert res.returncode == 0, res.stderr[-3000:]
     stats = (res.stdout + res.stderr).split("Job stats:", 1)[1].split("\ntotal", 1)[0]
     ran = set(re.findall(r"^(\w+)\s+\d+$", stats, flags=re.M)) - {"job"}
@@ -852,6 +853,9 @@ def test_compare_pairs_a_new_method_with_the_reference_and_refuses_other_scenari
     reference = pd.read_parquet(wd / "paper/reference/frontier_confirm_runs.parquet")
     assert set(table["config"]) == set(reference["config"])  # NBO and every tuned member
     assert set(table["verdict"]) <= {"better", "worse", "equivalent", "inconclusive"}
+    itself = table[(table["method"] == "nbo") & (table["config"] == "nbo")].iloc[0]
+    assert (itself["mean_diff"], itself["low"], itself["high"]) == (0.0, 0.0, 0.0)
+    assert itself["verdict"] == "equivalent"
     runs = pd.read_csv(wd / "results/compare/runs/fp150.csv")
     assert sorted(runs["run"]) == sorted(reference.loc[reference.config == "nbo", "run"])
     report = (wd / "results/compare/report.md").read_text()
@@ -859,7 +863,7 @@ def test_compare_pairs_a_new_method_with_the_reference_and_refuses_other_scenari
     assert (wd / "results/compare/frontier.png").stat().st_size > 10_000
     # another seed: other scenarios, so nothing would pair: refused before any job
     before = (wd / "results/compare/paired.csv").read_bytes()
-    res = snakemake(wd, "-j1", "compare", "--config", f"plugin_methods=[{new}]", "seed=8")
+    res = snakemake(wd, "-j1", "compare", "--config", f"plugin_methods=[{new}, nbo]", "seed=8")
     assert res.returncode != 0
     assert "config seed (reference 7, this workflow 8)" in res.stderr
     assert "Traceback" not in res.stderr and "Job stats" not in res.stdout + res.stderr

@@ -30,7 +30,7 @@ def _claim(cid, verdict, value, lo, hi, margin=None, n=None):
     return Claim(cid, "c", "p", key, verdict, "r", setup="s")
 
 
-def test_at_most_ten_main_claims_named_before_the_run():
+def test_at_most_ten_main_claims_fixed_in_code():
     assert 1 <= len(MAIN_CLAIMS) <= MAX_MAIN == 10
     ids = [cid for m in MAIN_CLAIMS for _, cid in m.setups]
     assert len(ids) == len(set(ids))
@@ -46,6 +46,15 @@ def test_an_equivalence_whose_ci_excludes_zero_says_so():
     )
     assert verdict_text(_claim("A", "equivalent", 0.01, -0.05, 0.07, margin=0.1)) == "equivalent"
     assert verdict_text(_claim("A", "supported", -0.4, -0.5, -0.3)) == "supported"
+    # Holm's correction made it inconclusive: said, with what it was without it
+    from dataclasses import replace
+
+    holm = replace(
+        _claim("A", "inconclusive", -0.05, -0.2, 0.08),
+        rule="r. Holm over 11 FR/HZ claims: p = 0.0512 ≥ 0.05: equivalent without it, "
+        "becomes inconclusive",
+    )
+    assert verdict_text(holm) == "inconclusive (after Holm, p = 0.0512; equivalent without it)"
 
 
 def test_main_rows_put_the_setups_side_by_side_with_power():

@@ -100,3 +100,16 @@ def test_the_committed_history_loads_and_covers_the_published_claims():
     published = json.loads((ROOT / "paper/claims.json").read_text(encoding="utf-8"))
     ids = {c["id"] for c in published["claims"]}
     assert ids <= set(h.loc[h["kind"] == "implementation", "claim"])
+
+
+def test_this_runs_own_published_row_is_not_an_earlier_run():
+    h = load_history(None)
+    for label, verdict in [("a", "inconclusive"), ("b", "equivalent")]:
+        h = add_claims(
+            h, [_record("U-3", verdict, -0.05)], kind="implementation", label=label, date=label
+        )
+    # make publish added run b's row; rendering run b again must not count it twice
+    assert fragility(_claim(), h, run="b") == (
+        "published runs: inconclusive (a) → equivalent (this run)"
+    )
+    assert fragility(_claim(), h).endswith("equivalent (b to this run, 2 runs)")

@@ -3,6 +3,8 @@
 # (one thread: the time is the study's measure of compute), then aggregation and the figure.
 import json
 
+import numpy as np
+
 from rsmhp.studies.frontier.figures import CONFIRM_FIGURES
 from rsmhp.studies.frontier.figures import FIGURES as FRONTIER_FIGURES
 from rsmhp.studies.frontier.section import CONFIRM_TABLES
@@ -447,6 +449,8 @@ if CONFIRM is not None:
             "stream": CONFIRM["stream"],
             "seed": config["seed"],
             "track_loss_error": FRONTIER["track_loss_error"],
+            # numpy does not promise the same random streams across versions (NEP 19)
+            "numpy": np.__version__,
         },
     )
     LADDER = ladder_rows(

@@ -1,10 +1,12 @@
 """The one-page answer: the claims the main text shows, how a verdict reads, and the values of
 "What we found".
 
-:data:`MAIN_CLAIMS` names, before any run, the at most ten claims of the main text: the
-paper's statements tested on several setups and the benchmark's own comparisons, one row
-each with its setups side by side (the ids are fixed here, so the judging data cannot choose
-them). Every other claim stays in the appendix ledger; the checks of our own machinery
+:data:`MAIN_CLAIMS` names the at most ten claims of the main text: the paper's statements
+tested on several setups and the benchmark's own comparisons, one row each with its setups
+side by side. The ids are fixed in code, not chosen per run: a run's verdicts cannot move a
+claim into or out of the main text (the list was written after earlier runs had been
+published, so it is a fixed choice, not a preregistered one). Every other claim stays in
+the appendix ledger; the checks of our own machinery
 (``Claim.check``) have an appendix part and a count of their own.
 
 :func:`verdict_text` says what a verdict means (an equivalence whose CI excludes the null:
@@ -138,10 +140,18 @@ def key_text(c: Claim) -> str:
     return out + (f" {k.unit}" if k.unit else "")
 
 
+_HOLM = re.compile(r"p = ([^ ]+) ≥ [^:]+: ([a-z ]+) without it, becomes inconclusive")
+
+
 def verdict_text(c: Claim) -> str:
     """The verdict as it reads: ``equivalent (difference significant but below Δ = 0.25 m)``
-    when the CI of an equivalent key number excludes its null, else the verdict."""
+    when the CI of an equivalent key number excludes its null; ``inconclusive (after Holm,
+    p = 0.0512; equivalent without it)`` when Holm's correction made it inconclusive; else
+    the verdict."""
     k = c.key
+    m = _HOLM.search(c.rule)
+    if c.verdict == "inconclusive" and m:
+        return f"inconclusive (after Holm, p = {m.group(1)}; {m.group(2)} without it)"
     if c.verdict == "equivalent" and k.has_ci and k.null is not None:
         if not k.ci_low <= k.null <= k.ci_high:
             delta = f"Δ = {fmt(k.margin, 3)}{' ' + k.unit if k.unit else ''}" if k.margin else "Δ"
@@ -156,7 +166,8 @@ def _power_text(c: Claim) -> str:
     need = runs_needed(k)
     if need is None:
         return f"; n = {k.n}, no n decides it at this estimate"
-    return f"; n = {k.n}, {need} for 80% power"
+    holm = " before Holm" if k.p_holm is not None else ""
+    return f"; n = {k.n}, {need} for 80% power{holm}"
 
 
 def main_rows(claims: Sequence[Claim], appendix: str = "appendix.md") -> list[dict[str, str]]:

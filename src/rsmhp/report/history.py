@@ -132,11 +132,14 @@ def _runs(labels: Sequence[str], verdicts: Sequence[str]) -> str:
     return " → ".join(parts)
 
 
-def fragility(claim: Claim, history: pd.DataFrame) -> str:
+def fragility(claim: Claim, history: pd.DataFrame, run: str | None = None) -> str:
     """The fragility line of ``claim`` (empty when every verdict it has had agrees): per
     kind of earlier judgement, the verdicts in order; with a ``null`` of 0, whether the key
-    number changed sign."""
+    number changed sign. ``run``: this run's label (its commit, 7 characters): a published
+    row of this very run (``make publish`` adds one) is this run, not an earlier one."""
     rows = history[history["claim"] == claim.id]
+    if run:
+        rows = rows[~((rows["kind"] == "implementation") & (rows["label"] == run[:7]))]
     if rows.empty:
         return ""
     seen = set(rows["verdict"]) | {v for v in rows["against"] if isinstance(v, str)}

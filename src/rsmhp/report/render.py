@@ -58,7 +58,7 @@ def claims_table(claims: Iterable[Claim]) -> str:
     """The claims: id, claim (with its scope), the setup it was tested on, our key number
     with its 95% CI, verdict, the rule that gave it, and the contrary evidence (cells or
     settings whose CI lies on the opposite side). What the paper says is in the statements
-    table (part 1) and in each claim's details (appendix)."""
+    table and in each claim's details (appendix)."""
     lines = [
         "| id | claim | setup | our number (95% CI) | verdict | verdict rule | contrary evidence |",
         "|---|---|---|---|---|---|---|",
@@ -97,7 +97,7 @@ def statements_table(judgements: Iterable[Judgement], appendix: str = "appendix.
 
 
 def statements_records(judgements: Iterable[Judgement]) -> list[dict[str, Any]]:
-    """Part one as JSON-ready dicts (``statements`` of ``claims.json``)."""
+    """The statements' judgements as JSON-ready dicts (``statements`` of ``claims.json``)."""
     return [
         {
             "id": j.statement.id,
@@ -190,7 +190,10 @@ MAIN_POLICY = (
     "the claim in the appendix (linked): **supported** only when the 95% CI of the key number "
     "lies entirely on the claimed side, **not supported** when it lies on the opposite side "
     "(or contradicts a closed form), **equivalent** when it lies inside a margin ±Δ fixed "
-    "before the run, **inconclusive** otherwise."
+    "before the run, **inconclusive** otherwise. Two rules add a condition: the FR and HZ "
+    "claims are Holm-corrected together (a decisive verdict whose adjusted p is 0.05 or more "
+    "becomes inconclusive, and says so), and DEC-8 needs its CI below 0 in every cell of the "
+    "group as well as on average."
 )
 
 
@@ -235,14 +238,14 @@ def _statements_part(
 
 
 def _main_claims_part(
-    claims: Sequence[Claim], history: pd.DataFrame | None, appendix: str
+    claims: Sequence[Claim], history: pd.DataFrame | None, appendix: str, run: str | None
 ) -> list[str]:
     rows = main_rows(claims, appendix)
     shown = {cid for m in MAIN_CLAIMS for _, cid in m.setups}
     fragile = []
     if history is not None:
         for c in claims:
-            if c.id in shown and (line := fragility(c, history)):
+            if c.id in shown and (line := fragility(c, history, run)):
                 fragile.append(f"- {link(c.id, appendix)} ({c.verdict}): {line}")
     n_other = sum(1 for c in claims if c.id not in shown and not c.check)
     n_checks = sum(c.check for c in claims)
@@ -353,7 +356,7 @@ def render_report(
         "",
         *figure,
         *_statements_part(judgements, untested, appendix),
-        *_main_claims_part(claims, history, appendix),
+        *_main_claims_part(claims, history, appendix, provenance.get("commit")),
         *_studies_part(sections),
         "## Provenance",
         "",
@@ -383,6 +386,7 @@ def _ledger_part(
     claims: Sequence[Claim],
     statements: Sequence[Statement] | None,
     history: pd.DataFrame | None,
+    run: str | None,
 ) -> list[str]:
     judgements, _ = judge_all(claims, statements)
     notes = [f"- {j.statement.id}: {j.statement.note}" for j in judgements if j.statement.note]
@@ -393,7 +397,9 @@ def _ledger_part(
     fragile = []
     if history is not None:
         fragile = [
-            f"- {c.id} ({c.verdict}): {line}" for c in claims if (line := fragility(c, history))
+            f"- {c.id} ({c.verdict}): {line}"
+            for c in claims
+            if (line := fragility(c, history, run))
         ]
     return [
         "## A. The ledger",
@@ -454,12 +460,13 @@ def render_appendix(
     parameters of the run and provenance."""
     sections = sorted(sections, key=lambda s: (s.order, s.key))
     claims = [c for s in sections for c in s.claims]
+    run = provenance.get("commit")
     parts = [
         "# rsmhp replication report: appendix",
         "",
         "Details behind [the main text](replication.md), from the same run.",
         "",
-        *_ledger_part(claims, statements, history),
+        *_ledger_part(claims, statements, history, run),
         "## B. Claims in detail",
         "",
     ]
@@ -483,7 +490,7 @@ def render_appendix(
             parts.append(f"- Contrary evidence: {c.contrary}")
         if c.dropped:
             parts.append(f"- Left out: {c.dropped}")
-        if history is not None and (line := fragility(c, history)):
+        if history is not None and (line := fragility(c, history, run)):
             parts.append(f"- Fragile: {line}")
         parts.append("")
     for i, s in enumerate(sections, start=1):

@@ -302,7 +302,8 @@ def _dec8_claim(
             reproducible="statistical",
             digits=3,
             null=0.0,
-            n=_units(g["n_runs"]),
+            # no n: the rule needs every cell of the group, so no one number of runs
+            # decides it (the runs per cell are in the measured text)
         ),
         DEC8_RULE.verdict(map_facts(g)),
         DEC8_RULE.text(),
