@@ -623,6 +623,8 @@ def test_slurm_profile_plans_every_rule(tmp_path):
     # ... and the protocol's tuning (its own target, `make tune`) and the exploratory target
     targets |= {"tune", "frontier_tune", "frontier_tune_timing", "frontier_tune_select"}
     targets |= {"frontier_exploratory"}
+    # ... and the comparison of new planners with the reference (make compare)
+    targets |= {"compare", "frontier_compare", "frontier_compare_run"}
     assert planned == every - targets
     profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
     assert profile["executor"] == "slurm"
