@@ -859,7 +859,9 @@ def test_compare_pairs_a_new_method_with_the_reference_and_refuses_other_scenari
     assert (itself["mean_diff"], itself["low"], itself["high"]) == (0.0, 0.0, 0.0)
     assert itself["verdict"] == "equivalent"
     runs = pd.read_csv(wd / "results/compare/runs/fp150.csv")
-    assert sorted(runs["run"]) == sorted(reference.loc[reference.config == "nbo", "run"])
+    for method in (new, "nbo"):  # each new method on exactly the reference's runs
+        mine = runs.loc[runs["config"] == method, "run"]
+        assert sorted(mine) == sorted(reference.loc[reference.config == "nbo", "run"])
     report = (wd / "results/compare/report.md").read_text()
     assert f"## {new} on 'fp150'" in report and "not rerun" in report
     assert (wd / "results/compare/frontier.png").stat().st_size > 10_000
