@@ -24,7 +24,7 @@ import yaml
 from rsmhp.report.findings import MAIN_CLAIMS, found_values, key_text, link, main_rows, verdict_text
 from rsmhp.report.history import fragility
 from rsmhp.report.ledger import STATEMENT_VERDICTS, VERDICTS, Claim, Section
-from rsmhp.report.markdown import escape, fmt, fmt_ci
+from rsmhp.report.markdown import escape
 from rsmhp.report.power import runs_text
 from rsmhp.report.statements import GENERAL_RULE, HEDGED_RULE, Judgement, Statement, judge_all
 from rsmhp.report.templates import render as render_template
@@ -46,12 +46,7 @@ __all__ = [
 
 
 def _ledger_number(c: Claim) -> str:
-    k = c.key
-    signed = k.null == 0.0
-    out = fmt(k.value, k.digits, signed)
-    if k.has_ci:
-        out += " " + fmt_ci(k.ci_low, k.ci_high, k.digits, signed)
-    return f"{k.name}: {out}{' ' + k.unit if k.unit else ''}"
+    return f"{c.key.name}: {key_text(c)}"
 
 
 def claims_table(claims: Iterable[Claim]) -> str:
