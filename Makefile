@@ -35,8 +35,8 @@ $(STAMP): pyproject.toml
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install --quiet --upgrade pip
 	$(BIN)/python -m pip install --quiet -e '.[dev]'
-	@# compile the numba planner kernels once per machine (on-disk cache; every job loads it)
-	$(BIN)/python -c 'from rsmhp.models.uav import fused; from rsmhp.models.lqg import regret as d; print(f"compiled kernels ready in {fused.warm_up() + d.warm_up():.1f} s")'
+	@# compile every numba kernel once per machine, in parallel (on-disk cache; every job loads it)
+	$(BIN)/python -m rsmhp.pipeline.warm --cores $(CORES)
 	@touch $(STAMP)
 
 setup: $(STAMP)

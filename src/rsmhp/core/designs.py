@@ -40,6 +40,7 @@ __all__ = [
     "monte_carlo",
     "sobol",
     "sobol_points",
+    "warm_up",
 ]
 
 STOCHASTIC = ("mc", "antithetic", "sobol")
@@ -218,3 +219,13 @@ def gauss_hermite(q: int, H: int, chol: np.ndarray):
     z = np.stack([g.ravel() for g in grids], axis=1)
     wts = np.prod(np.meshgrid(*([w] * D), indexing="ij"), axis=0).ravel()
     return _shape(z, H, chol), wts
+
+
+def warm_up() -> float:
+    """Compile (or load from the cache) the scrambled Sobol' kernel; returns the seconds it
+    took."""
+    import time
+
+    t0 = time.perf_counter()
+    sobol_points(np.random.default_rng(0), 2, 2)
+    return time.perf_counter() - t0

@@ -94,7 +94,7 @@ from rsmhp.core import numba_cache
 from rsmhp.models.uav import stepper as _stepper
 from rsmhp.models.uav.stepper import _advance
 
-__all__ = ["PURSUIT_TAU", "ROLLOUTS", "SearchResult", "pursuit", "search"]
+__all__ = ["PURSUIT_TAU", "ROLLOUTS", "SearchResult", "pursuit", "search", "warm_up"]
 
 #: the rollout policies: index = the compiled code's mode (0 warm start, 1 pursuit)
 ROLLOUTS = ("warm", "pursuit")
@@ -482,6 +482,30 @@ def search(
         plan, float(cost), int(nb), int(na), int(n_root), int(n_chosen), float(best),
         int(max_depth), hist, int(depth), int(n_gen), int(n_tail),
     )  # fmt: skip
+
+
+def warm_up() -> float:
+    """Compile (or load from the cache) the tree search (:func:`search`, which links the
+    closed-loop step of :mod:`rsmhp.models.uav.stepper`) and :func:`pursuit`; returns the seconds
+    it took."""
+    import time
+
+    from rsmhp.models.uav.kinematics import UAVParams
+    from rsmhp.models.uav.sensor import SensorModel
+    from rsmhp.models.uav.target import TargetModel
+
+    t0 = time.perf_counter()
+    step = _stepper.Stepper(
+        UAVParams(1.0, 9.81, 3.0, 0.7, 10.0, 35.0, 100.0),
+        TargetModel(1.0, 1.0),
+        SensorModel(0.05, 0.1, 100.0),
+    )
+    uav, x_hat = np.array([0.0, 0.0, 20.0, 0.0]), np.array([50.0, 0.0, 1.0, 0.0])
+    scale = np.array([3.0, 0.7])
+    search(uav, x_hat, np.eye(4), np.zeros((2, 2)), scale, 4, (1.0, 1.0, 0.5, 1.0, 0.5), step,
+           np.random.default_rng(0))  # fmt: skip
+    pursuit(uav, x_hat, step)
+    return time.perf_counter() - t0
 
 
 # the compiled search links the closed-loop step of rsmhp.models.uav.stepper into its cached code:

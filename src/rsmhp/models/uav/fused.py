@@ -59,10 +59,11 @@ so they give the same bits. :func:`minimise` runs a whole planning step
 (:func:`rsmhp.core.boxqn.minimise` on this cost) in one compiled call.
 
 Compilation: numba ``njit`` with ``cache=True``; the first call on a machine compiles (about
-a minute for every kernel, :func:`warm_up`) and writes the cache beside this file, or in
-numba's user-wide cache directory when the install is read-only (or in ``NUMBA_CACHE_DIR``
-when set); later processes load it. Single-threaded: parallelism is across closed-loop runs
-(joblib), never inside the kernel.
+half a minute for the planner's kernels, :func:`warm_up`; ``python -m rsmhp.pipeline.warm``
+compiles every kernel of the project in parallel processes) and writes the cache beside this
+file, or in numba's user-wide cache directory when the install is read-only (or in
+``NUMBA_CACHE_DIR`` when set); later processes load it. Single-threaded: parallelism is across
+closed-loop runs (joblib), never inside the kernel.
 """
 
 from __future__ import annotations
@@ -109,7 +110,16 @@ llvm.set_option("rsmhp", "-vectorize-memory-check-threshold=512")
 SOA_MIN_HYPOTHESES = 24
 
 # --------------------------------------------------------------------------------------------
-# compiled building blocks (inlined by LLVM; tuples of scalars, no heap allocation)
+# compiled building blocks (tuples of scalars, no heap allocation)
+#
+# Inlining: the blocks the vectorised loops need inline in their loop body
+# (``_meas_cov``, ``_kalman_step``, ``_adjoint_step``, ``_meas_cov_grad``) are inlined by numba
+# (``inline="always"``, before typing), because LLVM's cost model leaves them as calls and a
+# loop with a call does not vectorise (measured: 15x slower at 256 hypotheses). The small ones
+# (``_mm``, ``_mmt``, ``_sub``) and those outside the hypothesis loops (``_detection``, in its
+# own scalar loop; the kinematics and their adjoint) are ordinary compiled functions, which
+# LLVM inlines where it pays: numba types an inlined function again at every call site, and
+# these sites were a quarter of the kernel's compile time (39 s -> 28 s CPU, same speed).
 
 
 @njit(cache=True, inline="always")
@@ -217,7 +227,7 @@ def _kalman_step(p, rxx, rxy, ryy, dt, q, pd, limited):  # pragma: no cover - co
     return out, (m11, m12, m21, m22), (n11, n12, n21, n22), x
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _detection(ux, uy, tx, ty, sens):  # pragma: no cover - compiled
     """(p_d, dp_d/d uav_x, dp_d/d uav_y) of the logistic footprint (see rsmhp.models.uav.sensor);
     the derivative is taken as 0 directly overhead (rho = 0)."""
@@ -231,7 +241,7 @@ def _detection(ux, uy, tx, ty, sens):  # pragma: no cover - compiled
     return pd, k * dx, k * dy
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _mm(a, b):  # pragma: no cover - compiled
     """2x2 product of row-major 4-tuples."""
     return (
@@ -242,7 +252,7 @@ def _mm(a, b):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _mmt(a, b):  # pragma: no cover - compiled
     """a @ b.T for row-major 2x2 4-tuples."""
     return (
@@ -253,7 +263,7 @@ def _mmt(a, b):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _sub(a, b):  # pragma: no cover - compiled
     return (a[0] - b[0], a[1] - b[1], a[2] - b[2], a[3] - b[3])
 
@@ -350,7 +360,7 @@ def _meas_cov_grad(ux, uy, tx, ty, rbar, sens):  # pragma: no cover - compiled
     return -gvx, -gvy
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _kinematics(
     xc, state0, amax, phimax, dt, g, smin, smax, uxy, spd, hdg, inside
 ):  # pragma: no cover
@@ -387,7 +397,7 @@ def _path_kernel(xc, state0, cfg, out):  # pragma: no cover - compiled
     return out
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True)
 def _kinematics_adjoint(xc, cfg, spd, hdg, inside, gxy, grad):  # pragma: no cover - compiled
     """dJ/dx (2H,) into ``grad`` from ``gxy`` (H, 2) = dJ/d(UAV position after step j) times
     the weight divisor (back-substitution of the kinematics; module docstring)."""
@@ -704,33 +714,42 @@ def _workspace(horizon, n_t, limited):  # pragma: no cover - compiled
     )
 
 
-@njit(cache=True, nogil=True)
-def _evaluate_kernel(
-    x, st, cfg, p0, q, sens, tx, ty, wts, want_grad, cost, grad
-):  # pragma: no cover
-    """:func:`_value_grad` for every row of ``x`` (C, 2H)."""
-    ws = _workspace(tx.shape[0], tx.shape[1], sens[5] != 0.0)
-    for c in range(x.shape[0]):
-        g_row = grad[c] if want_grad else grad[0]
-        cost[c] = _value_grad(x[c], st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad, g_row)
-    return cost, grad
+#: modes of :func:`_planner_kernel`
+_EVALUATE, _MINIMISE = 0, 1
 
 
 @njit(cache=True, inline="always", error_model="numpy")
 def _objective(x, grad, data):  # pragma: no cover - compiled
     """The planning cost and its gradient in :mod:`rsmhp.core.boxqn`'s calling convention."""
-    st, cfg, p0, q, sens, tx, ty, wts, ws = data
-    return _value_grad(x, st, cfg, p0, q, sens, tx, ty, wts, ws, True, grad)
+    st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad = data
+    return _value_grad(x, st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad, grad)
 
 
 @njit(cache=True, nogil=True)
-def _minimise_kernel(
-    x0, st, cfg, p0, q, sens, tx, ty, wts, maxiter, maxfun, x_out
-):  # pragma: no cover
+def _planner_kernel(
+    mode, x, st, cfg, p0, q, sens, tx, ty, wts, want_grad, maxiter, maxfun, cost, grad, x_out
+):  # pragma: no cover - compiled
+    """Both compiled entry points in one function, so that the two layouts are linked into
+    one kernel only. ``mode`` :data:`_EVALUATE`: :func:`_value_grad` for every row of ``x``
+    (C, 2H) into ``cost`` (C,) and, if ``want_grad``, ``grad`` (C, 2H); returns zeros.
+    :data:`_MINIMISE`: :func:`rsmhp.core.boxqn.minimise` of the cost from ``x[0]`` (2H,) with
+    ``want_grad`` true, the final point into ``x_out`` (2H,); returns ``(f, f0, nit, nfev,
+    status)``.
+
+    Why one function: numba links the layouts' compiled code into every kernel that calls them
+    and optimises the linked module again; for the vectorised layout that second pass took
+    12-14 s per calling kernel (measured: numba 0.68, LLVM host znver4), so two calling kernels
+    paid it twice. ``want_grad`` is a run-time ``bool`` in both modes (a literal ``True`` would
+    make numba compile both layouts a second time, for the literal's type)."""
     ws = _workspace(tx.shape[0], tx.shape[1], sens[5] != 0.0)
-    data = (st, cfg, p0, q, sens, tx, ty, wts, ws)
+    if mode == _EVALUATE:
+        for c in range(x.shape[0]):
+            g_row = grad[c] if want_grad else grad[0]
+            cost[c] = _value_grad(x[c], st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad, g_row)
+        return 0.0, 0.0, 0, 0, 0
+    data = (st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad)
     return boxqn.minimise(
-        _objective, data, x0, maxiter, maxfun, boxqn.MEMORY, boxqn.PGTOL, boxqn.FTOL, x_out
+        _objective, data, x[0], maxiter, maxfun, boxqn.MEMORY, boxqn.PGTOL, boxqn.FTOL, x_out
     )
 
 
@@ -920,6 +939,11 @@ class Frozen:
         )
 
 
+# the arguments :func:`_planner_kernel` does not use in a mode (the types of the used ones)
+_NO_POINT = np.empty(0)
+_NO_COST = np.empty(1)
+
+
 def evaluate(x: np.ndarray, frozen: Frozen, want_grad: bool) -> tuple[np.ndarray, np.ndarray]:
     """Costs (C,) and, if ``want_grad``, gradients (C, 2H) of ``x`` (C, 2H) (else (0, 0))."""
     x = np.ascontiguousarray(x, dtype=float)
@@ -930,7 +954,9 @@ def evaluate(x: np.ndarray, frozen: Frozen, want_grad: bool) -> tuple[np.ndarray
     n_c = x.shape[0]
     cost_out = np.empty(n_c)
     grad_out = np.empty((n_c, x.shape[1]) if want_grad else (1, x.shape[1]))
-    cost_out, grad_out = _evaluate_kernel(x, *frozen.args, want_grad, cost_out, grad_out)
+    _planner_kernel(
+        _EVALUATE, x, *frozen.args, bool(want_grad), 0, 0, cost_out, grad_out, _NO_POINT
+    )
     return cost_out, (grad_out if want_grad else np.empty((0, 0)))
 
 
@@ -944,7 +970,10 @@ def minimise(
     if x0.size != 2 * frozen.horizon:
         raise ValueError(f"x0 must have 2H = {2 * frozen.horizon} entries, got {x0.size}")
     x_out = np.empty_like(x0)
-    f, f0, nit, nfev, status = _minimise_kernel(x0, *frozen.args, int(maxiter), int(maxfun), x_out)
+    f, f0, nit, nfev, status = _planner_kernel(
+        _MINIMISE, x0[None, :], *frozen.args, True, int(maxiter), int(maxfun),
+        _NO_COST, np.empty((1, x0.size)), x_out,
+    )  # fmt: skip
     return x_out, float(f), float(f0), int(nit), int(nfev), int(status)
 
 
@@ -1004,14 +1033,13 @@ def _controls(x: np.ndarray, frozen: Frozen) -> np.ndarray:
 
 
 def warm_up() -> float:
-    """Compile (or load from the cache) every kernel of the UAV case study: the planner's
-    (cost, gradient, planning step, path), the hypotheses'
-    (:func:`rsmhp.models.uav.target.pruned_tree`,
-    the propagation) and the closed-loop step's (:mod:`rsmhp.models.uav.stepper`); returns the
-    seconds it took."""
+    """Compile (or load from the cache) the planner's kernels: :func:`evaluate` and
+    :func:`minimise` (one compiled function, both layouts), :func:`covariance_traces` and
+    :func:`path`; returns the seconds it took. The hypotheses' and the closed-loop step's
+    kernels have their own (``rsmhp.models.uav.target.warm_up``,
+    ``rsmhp.models.uav.stepper.warm_up``); :mod:`rsmhp.pipeline.warm` runs them all in
+    parallel processes."""
     import time
-
-    from rsmhp.models.uav import stepper, target
 
     t0 = time.perf_counter()
     uav = UAVParams(1.0, 9.81, 3.0, 0.7, 10.0, 35.0, 100.0)
@@ -1019,22 +1047,13 @@ def warm_up() -> float:
     txy, eye, state = np.zeros((1, 2, 2)), np.eye(4), np.array([1.0, 0.0, 20.0, 0.0])
     frozen = Frozen(state, uav, eye, txy, 1.0, eye, sensor)
     evaluate(np.zeros((1, 4)), frozen, want_grad=True)
-    evaluate(np.zeros((1, 4)), frozen, want_grad=False)
+    minimise(np.zeros(4), frozen, 1, 2)
     covariance_traces(eye, np.zeros((1, 2, 2)), txy, 1.0, eye, sensor)
     path(np.zeros(4), frozen)
-    minimise(np.zeros(4), frozen, 1, 2)
-    wide = Frozen(state, uav, eye, np.zeros((SOA_MIN_HYPOTHESES, 2, 2)), 1.0, eye, sensor)
-    evaluate(np.zeros((1, 4)), wide, want_grad=True)  # the same kernels, the other layout
-    # the variants run the same compiled code (flags are runtime values), nothing to add
-    model = target.TargetModel(1.0, 1.0)
-    target.pruned_tree(np.zeros(4), eye, 1, 2, 1, model, np.random.default_rng(0))
-    target.nominal(np.zeros(4), 2, model)
-    step = stepper.Stepper(uav, model, sensor)
-    step.advance(
-        state.copy(), np.ones(4), np.ones(4), eye.copy(), np.zeros(2), np.zeros(4), np.zeros(2), 0.5
-    )
+    # the other layout, the value alone and the sensor variants run the same compiled code
+    # (hypothesis count, want_grad and the variants' flags are run-time values)
     return time.perf_counter() - t0
 
 
 # the compiled planning step inlines rsmhp.core.boxqn: numba's cache does not see edits there
-numba_cache.invalidate_if_changed(_minimise_kernel, [boxqn])
+numba_cache.invalidate_if_changed(_planner_kernel, [boxqn])

@@ -35,7 +35,7 @@ from rsmhp.models.uav.kinematics import UAVParams
 from rsmhp.models.uav.sensor import SensorModel
 from rsmhp.models.uav.target import TargetModel
 
-__all__ = ["Stepper"]
+__all__ = ["Stepper", "warm_up"]
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -190,3 +190,19 @@ class Stepper:
             self.ucfg, self.sens,
         )  # fmt: skip
         return bool(seen), float(err), float(tr)
+
+
+def warm_up() -> float:
+    """Compile (or load from the cache) the closed-loop step; returns the seconds it took."""
+    import time
+
+    t0 = time.perf_counter()
+    step = Stepper(
+        UAVParams(1.0, 9.81, 3.0, 0.7, 10.0, 35.0, 100.0),
+        TargetModel(1.0, 1.0),
+        SensorModel(0.05, 0.1, 100.0),
+    )
+    state, eye = np.array([1.0, 0.0, 20.0, 0.0]), np.eye(4)
+    zeros = np.zeros(4)
+    step.advance(state, np.ones(4), np.ones(4), eye.copy(), np.zeros(2), zeros, np.zeros(2), 0.5)
+    return time.perf_counter() - t0

@@ -55,6 +55,7 @@ __all__ = [
     "pruned_tree_reference",
     "sample_independent",
     "transition_matrix",
+    "warm_up",
 ]
 
 
@@ -476,3 +477,15 @@ def pruned_tree_reference(
     order = top_m(tree.leaves.log_likeliness, len(tree.leaves))
     # states[:, 0] is x_hat, states[:, 1] the drawn current state, then H steps ahead
     return tree.leaves.states[order, 2:], tree.leaves.log_likeliness[order]
+
+
+def warm_up() -> float:
+    """Compile (or load from the cache) the hypotheses' kernels (:func:`pruned_tree`,
+    :func:`nominal`); returns the seconds it took."""
+    import time
+
+    t0 = time.perf_counter()
+    model = TargetModel(1.0, 1.0)
+    pruned_tree(np.zeros(4), np.eye(4), 1, 2, 1, model, np.random.default_rng(0))
+    nominal(np.zeros(4), 2, model)
+    return time.perf_counter() - t0

@@ -1,0 +1,93 @@
+"""Compile every numba kernel of the project once per machine, in parallel processes.
+
+numba compiles a kernel on its first call and keeps the machine code in its on-disk cache
+(``cache=True``: beside the module, in numba's user-wide cache directory when the install is
+read-only, or in ``NUMBA_CACHE_DIR``); every later process, every workflow job included,
+loads it in milliseconds. A fresh clone, a CI run or a cluster node without the cache pays the
+compilation once; this module pays it up front, in ``make setup`` (which ``make replicate``
+and ``make test`` run first), spread over the machine's cores.
+
+What is compiled, by whom (:data:`TASKS`; each task in its own process, largest first):
+
+* the planner kernel (:mod:`rsmhp.models.uav.fused`: cost, gradient and the whole planning
+  step in one compiled function, plus the covariance traces and the path): most of the time;
+* the rest: the tree search with the closed-loop step it links
+  (:mod:`rsmhp.models.uav.dpw`, :mod:`rsmhp.models.uav.stepper`), the hypotheses
+  (:mod:`rsmhp.models.uav.target`), the scrambled Sobol' points (:mod:`rsmhp.core.designs`) and
+  the LQG pruned tree (:mod:`rsmhp.models.lqg.regret`).
+
+Modules whose compiled code links another module's (the tree search links the closed-loop
+step) share a task, so no kernel is compiled twice at once. A kernel that is already in the
+cache loads in well under a second, so running this again costs little. The cache is per CPU
+target: numba keys it on the LLVM CPU name and features, so ``NUMBA_CPU_NAME`` (the AVX2 and
+portability emulations) compiles again, once.
+
+    python -m rsmhp.pipeline.warm [--cores N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import multiprocessing
+import os
+import time
+from concurrent.futures import ProcessPoolExecutor
+
+__all__ = ["LINKED", "TASKS", "main", "warm"]
+
+#: tasks of one process each: the modules whose ``warm_up()`` it calls, in order
+TASKS: tuple[tuple[str, ...], ...] = (
+    ("rsmhp.models.uav.fused",),
+    (
+        "rsmhp.models.uav.dpw",
+        "rsmhp.models.uav.stepper",
+        "rsmhp.models.uav.target",
+        "rsmhp.core.designs",
+        "rsmhp.models.lqg.regret",
+    ),
+)
+
+#: modules whose kernels are only ever called from another module's compiled code, and are
+#: compiled (and cached) with it: module -> the module whose task compiles them
+LINKED: dict[str, str] = {"rsmhp.core.boxqn": "rsmhp.models.uav.fused"}
+
+
+def _run(modules: tuple[str, ...]) -> list[tuple[str, float]]:
+    """Call each module's ``warm_up()`` (in this process); (module, seconds) per module."""
+    return [(name, float(importlib.import_module(name).warm_up())) for name in modules]
+
+
+def warm(cores: int) -> tuple[float, list[tuple[str, float]]]:
+    """Compile (or load) every kernel with ``cores`` processes (1: in this process); returns
+    (wall seconds, (module, seconds) per module)."""
+    if not isinstance(cores, int) or isinstance(cores, bool) or cores < 1:
+        raise ValueError(f"cores must be an integer >= 1, got {cores!r}")
+    t0 = time.perf_counter()
+    if cores == 1:
+        per = [row for task in TASKS for row in _run(task)]
+    else:
+        ctx = multiprocessing.get_context("spawn")
+        with ProcessPoolExecutor(max_workers=min(cores, len(TASKS)), mp_context=ctx) as pool:
+            per = [row for rows in pool.map(_run, TASKS) for row in rows]
+    return time.perf_counter() - t0, per
+
+
+def main(argv: list[str] | None = None) -> None:
+    parser = argparse.ArgumentParser(
+        prog="python -m rsmhp.pipeline.warm",
+        description="Compile every numba kernel of rsmhp into the on-disk cache, in parallel.",
+    )
+    parser.add_argument(
+        "--cores", type=int, default=os.cpu_count() or 1, help="processes (default: all cores)"
+    )
+    args = parser.parse_args(argv)
+    if args.cores < 1:
+        parser.error(f"--cores must be >= 1, got {args.cores}")
+    wall, per = warm(args.cores)
+    detail = ", ".join(f"{name.rsplit('.', 1)[-1]} {sec:.1f} s" for name, sec in per)
+    print(f"compiled kernels ready in {wall:.1f} s wall with {args.cores} cores ({detail})")
+
+
+if __name__ == "__main__":
+    main()

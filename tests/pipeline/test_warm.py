@@ -1,0 +1,80 @@
+"""The compile-once step (:mod:`rsmhp.pipeline.warm`): every kernel module is covered, a warm
+machine loads instead of compiling, and bad input is refused."""
+
+from __future__ import annotations
+
+import ast
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from rsmhp.pipeline import warm
+
+SRC = Path(__file__).resolve().parents[2] / "src"
+
+
+def _kernel_modules() -> set[str]:
+    """Modules of the package that define a cached numba kernel (``@njit(cache=True ...)``)."""
+    found = set()
+    for path in (SRC / "rsmhp").rglob("*.py"):
+        tree = ast.parse(path.read_text())
+        for node in ast.walk(tree):
+            if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "njit":
+                if any(k.arg == "cache" for k in node.keywords):
+                    found.add(".".join(path.relative_to(SRC).with_suffix("").parts))
+    return found
+
+
+def test_every_kernel_module_is_warmed():
+    covered = {m for task in warm.TASKS for m in task}
+    assert set(warm.LINKED.values()) <= covered
+    missing = _kernel_modules() - covered - set(warm.LINKED)
+    assert not missing, f"kernel modules without a place in warm.TASKS: {sorted(missing)}"
+    assert len(covered) == sum(len(t) for t in warm.TASKS), "a module is in two tasks"
+
+
+def test_warm_reports_every_module_and_a_warm_process_compiles_nothing():
+    wall, per = warm.warm(2)
+    assert [m for m, _ in per] == [m for task in warm.TASKS for m in task]
+    assert wall > 0 and all(s >= 0 for _, s in per)
+    # a fresh process after the warm-up: every kernel it calls is loaded, none compiled
+    code = r"""
+import json, importlib
+from rsmhp.pipeline import warm
+from numba.core.registry import CPUDispatcher
+for task in warm.TASKS:
+    for name in task:
+        importlib.import_module(name).warm_up()
+misses, hits = {}, 0
+for task in warm.TASKS:
+    for name in task:
+        mod = importlib.import_module(name)
+        for attr in vars(mod).values():
+            if isinstance(attr, CPUDispatcher):
+                hits += sum(attr.stats.cache_hits.values())
+                m = sum(attr.stats.cache_misses.values())
+                if m:
+                    misses[f"{name}.{attr.__name__}"] = m
+print(json.dumps({"misses": misses, "hits": hits}))
+"""
+    out = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, check=True
+    ).stdout
+    result = json.loads(out.strip().splitlines()[-1])
+    assert result["misses"] == {}
+    assert result["hits"] >= len(warm.TASKS)
+
+
+@pytest.mark.parametrize("cores", [0, -1, 1.5, True, "2"])
+def test_bad_cores_are_refused(cores):
+    with pytest.raises(ValueError, match="cores must be an integer >= 1"):
+        warm.warm(cores)
+
+
+def test_cli_refuses_zero_cores(capsys):
+    with pytest.raises(SystemExit):
+        warm.main(["--cores", "0"])
+    assert "--cores must be >= 1, got 0" in capsys.readouterr().err
