@@ -7,6 +7,9 @@ Three environment variables change the code paths a different x86-64 machine wou
 ``NUMBA_CPU_NAME=generic`` (numba's baseline x86-64 target, in a cache directory of its own),
 ``OPENBLAS_CORETYPE`` (OpenBLAS kernels of another core) and ``NPY_DISABLE_CPU_FEATURES``
 (numpy's runtime-dispatched SIMD loops off); see :mod:`rsmhp.report.portability`.
+:func:`cpu_target_env` sets the same variables for another named CPU model (an AVX2 machine
+without AVX-512: ``znver3``, ``Haswell``, :func:`numpy_avx512_targets`), for
+``benchmarks/cpu_targets.py`` and ``tests/models/uav/test_cpu_targets.py``.
 """
 
 from __future__ import annotations
@@ -24,14 +27,18 @@ from typing import Any
 from rsmhp.report.portability.hook import HOOK, PROBE
 
 __all__ = [
+    "AVX2_CORETYPE",
+    "AVX2_CPU",
     "COMPONENTS",
     "DEFAULT_CORETYPE",
     "RECORDS_ENV",
     "blas_cores",
     "copy_workflow",
+    "cpu_target_env",
     "emulation_env",
     "install_hook",
     "numba_cache_targets",
+    "numpy_avx512_targets",
     "probe",
     "provenance_blas",
     "read_records",
@@ -46,6 +53,10 @@ COMPONENTS = ("numba", "openblas", "numpy")
 
 #: environment variable naming the directory the hook writes its records to
 RECORDS_ENV = "RSMHP_DRILL_RECORDS"
+
+#: an AVX2 machine without AVX-512: LLVM's CPU model (Zen 3) and OpenBLAS's core type
+AVX2_CPU = "znver3"
+AVX2_CORETYPE = "Haswell"
 
 
 def probe(env: Mapping[str, str] | None = None, python: str = sys.executable) -> dict[str, Any]:
@@ -94,6 +105,42 @@ def emulation_env(
         filter(None, [str(drill_dir / "hook"), base.get("PYTHONPATH")])
     )
     env[RECORDS_ENV] = str(drill_dir / "records")
+    return env
+
+
+def numpy_avx512_targets() -> list[str]:
+    """The runtime-dispatch targets of this numpy that need AVX-512 (``X86_V4``, the
+    ``AVX512_*`` groups; numpy 1.x: ``AVX512F``, ``AVX512_SKX``, ...), in numpy's order: the
+    names ``NPY_DISABLE_CPU_FEATURES`` takes to leave numpy on its AVX2 loops. Taken from numpy
+    itself, as it rejects names that are not dispatch targets of its build."""
+    try:
+        from numpy._core._multiarray_umath import __cpu_dispatch__
+    except ImportError:  # numpy < 2
+        from numpy.core._multiarray_umath import __cpu_dispatch__
+    return [f for f in __cpu_dispatch__ if f == "X86_V4" or f.startswith("AVX512")]
+
+
+def cpu_target_env(
+    base: Mapping[str, str],
+    cpu: str = AVX2_CPU,
+    coretype: str | None = AVX2_CORETYPE,
+    numpy_disable: Sequence[str] = (),
+) -> dict[str, str]:
+    """``base`` with numba generating code for the LLVM CPU model ``cpu`` with that model's
+    own features (``NUMBA_CPU_NAME=cpu``, ``NUMBA_CPU_FEATURES`` empty: numba would otherwise
+    add the host's features, AVX-512 included, to any CPU name), the OpenBLAS core type
+    ``coretype`` (None: the host's) and numpy's SIMD targets ``numpy_disable`` switched off
+    (e.g. :func:`numpy_avx512_targets`). numba's cache directory is left as it is: its index
+    keys entries on the CPU name and features, so they sit beside the host's."""
+    env = dict(base)
+    env["NUMBA_CPU_NAME"] = cpu
+    env["NUMBA_CPU_FEATURES"] = ""
+    env.pop("OPENBLAS_CORETYPE", None)
+    if coretype:
+        env["OPENBLAS_CORETYPE"] = coretype
+    env.pop("NPY_DISABLE_CPU_FEATURES", None)
+    if numpy_disable:
+        env["NPY_DISABLE_CPU_FEATURES"] = " ".join(numpy_disable)
     return env
 
 
