@@ -28,15 +28,19 @@ Sub-packages
                     stepper (compiled closed-loop step), kernel (numpy oracle), fused (compiled
                     weighted cost + exact gradient), planner (Planner and Optimiser
                     protocols), methods (registry, one module per planning family), dpw
-                    (compiled tree search), simulation, scoring (open-loop scoring of belief
-                    states, shared by the studies), recording
+                    (compiled tree search), simulation, runs (closed-loop runs through the
+                    run store: their key, shared by the studies), scoring (open-loop scoring
+                    of belief states, shared by the studies), recording
   pipeline          workflow support: config (config files and schema checks, ``python -m
                     rsmhp.pipeline.config FILE``), contracts (what each intermediate holds),
                     io (atomic writers, checked readers), code_digest (the code each rule
-                    depends on, per method family where a rule runs some), parallel (joblib
-                    within a thread budget), resources (memory estimates), cluster (SLURM
+                    depends on, per method family where a rule runs some), runstore (the
+                    content-addressed store of computed runs, shared by the rules), parallel
+                    (joblib within a thread budget), resources (memory estimates), cluster (SLURM
                     pre-flight), protocol (seed streams, planner configurations, tuning rule,
-                    preregistration), script (logging and code checks of rule scripts)
+                    preregistration), script (logging and code checks of rule scripts), warm
+                    (compiles every numba kernel once per machine, ``python -m
+                    rsmhp.pipeline.warm``)
   report            ledger (KeyNumber, Claim, Section), verdicts (verdict rules as objects),
                     statements (the paper's statements judged on its setups and on variants),
                     findings (the main claims, "What we found"), power (runs at 80% power),

@@ -5,6 +5,17 @@ from rsmhp.pipeline.code_digest import method_only
 
 THREADS = config["threads"]
 
+# Keys that change no number of any output: run_store only says where closed-loop runs are
+# kept (rsmhp.pipeline.runstore; jobs read it from the config, it is no rule's param). The
+# rules that record the whole config (provenance, its config sha256) get it without them,
+# so moving or disabling the store changes neither the hash `make verify` compares nor any
+# job's params.
+NUMBERS_CONFIG = {k: v for k, v in config.items() if k != "run_store"}
+# `--config run_store=null` arrives as the string "null" (Snakemake keeps a top-level value
+# it cannot read as a number or bool a string): it means no store, as `run_store: null` does
+if config.get("run_store") == "null":
+    config["run_store"] = None
+
 # Scheduling: Snakemake starts the set of ready jobs that fits in the free cores with the
 # largest sum of priorities. The longest jobs (estimator ablation, UAV decision study: threads
 # from the config, 1 by default; then the equal-compute study, one job per model) get

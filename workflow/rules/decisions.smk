@@ -133,6 +133,8 @@ rule decisions_map_cell:
         seed=config["seed"],
         families=DEC_MAP_FAMILIES,
         code=code_digest("workflow/scripts/decisions_map_cell.py", DEC_MAP_FAMILIES),
+    # closed-loop runs go through the run store (config run_store: the script reads it,
+    # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
         "../scripts/decisions_map_cell.py"
 

@@ -70,6 +70,8 @@ rule frontier_explore:
         seed=config["seed"],
         families=FRONTIER_FAMILIES,
         code=code_digest("workflow/scripts/frontier_explore.py", FRONTIER_FAMILIES),
+    # closed-loop runs go through the run store (config run_store: the script reads it,
+    # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
         "../scripts/frontier_explore.py"
 
@@ -226,6 +228,8 @@ rule frontier_tune:
         seed=config["seed"],
         families=FRONTIER_FAMILIES,
         code=code_digest("workflow/scripts/frontier_tune.py", FRONTIER_FAMILIES),
+    # closed-loop runs go through the run store (config run_store: the script reads it,
+    # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
         "../scripts/frontier_tune.py"
 
@@ -278,7 +282,7 @@ rule frontier_tune_select:
         models=FRONTIER_MODELS,
         tuning=canonical(TUNING),
         seed=config["seed"],
-        config=canonical(config),
+        config=canonical(NUMBERS_CONFIG),
         code=code_digest("workflow/scripts/frontier_tune_select.py"),
     script:
         "../scripts/frontier_tune_select.py"
@@ -329,6 +333,8 @@ rule frontier_confirm:
         seed=config["seed"],
         families=FRONTIER_FAMILIES,
         code=code_digest("workflow/scripts/frontier_confirm.py", FRONTIER_FAMILIES),
+    # closed-loop runs go through the run store (config run_store: the script reads it,
+    # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
         "../scripts/frontier_confirm.py"
 
@@ -547,6 +553,8 @@ rule frontier_compare_run:
         # the new methods' own code (a plugin's modules live outside src/)
         plugins=method_sources(COMPARE_METHODS),
         code=code_digest("workflow/scripts/frontier_compare_run.py"),
+    # closed-loop runs go through the run store (config run_store: the script reads it,
+    # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
         "../scripts/frontier_compare_run.py"
 

@@ -99,6 +99,8 @@ rule horizon_uav_closed:
         seed=HZ_SEED,
         families=HZ_FAMILIES,
         code=code_digest("workflow/scripts/horizon_uav_closed.py", HZ_FAMILIES),
+    # closed-loop runs go through the run store (config run_store: the script reads it,
+    # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
         "../scripts/horizon_uav_closed.py"
 

@@ -41,7 +41,7 @@ rule report:
         mem_mb=500,
         runtime=5,
     params:
-        config=canonical(config),
+        config=canonical(NUMBERS_CONFIG),
         # the preregistration the confirmatory claims were judged under (claims.json,
         # make verify): path and sha256 (the script adds the commit that added it)
         preregistration=(

@@ -59,6 +59,8 @@ rule uav_simulate:
         code=lambda wc: code_digest(
             "workflow/scripts/uav_simulate.py", families_of([UAV_SPECS[wc.method]])
         ),
+    # closed-loop runs go through the run store (config run_store: the script reads it,
+    # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
         "../scripts/uav_simulate.py"
 

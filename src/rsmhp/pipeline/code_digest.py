@@ -68,6 +68,7 @@ __all__ = [
     "code_digest",
     "describe",
     "method_only",
+    "module_digest",
     "split_stamp_rule",
     "workflow_src",
 ]
@@ -377,3 +378,29 @@ def split_stamp_rule(rule: str) -> tuple[str, list[str] | None]:
     ``report`` has no restriction (``None``)."""
     name, plus, families = rule.partition("+")
     return name, (families.split(",") if plus else None)
+
+
+def module_digest(
+    modules: Iterable[str],
+    src: str | os.PathLike | None = None,
+    only: Mapping[str, Iterable[str]] | None = None,
+) -> CodeDigest:
+    """The digest of the code that importing ``modules`` (dotted ``rsmhp`` module names) can
+    run: :func:`describe` of a script whose only lines are ``import <module>``, one per
+    module, sorted, so that the digest depends on the set of names and on the code they
+    reach, not on the order or on where the script would live. ``src`` and ``only`` as for
+    :func:`describe` (e.g. ``module_digest(["rsmhp.models.uav.simulation"],
+    only=method_only(["nbo"]))``: the closed loop of the NBO family alone). A name that is
+    not an ``rsmhp`` module under ``src`` is refused, naming it."""
+    names = sorted({str(m) for m in modules})
+    if not names:
+        raise ValueError("module_digest: modules is empty (name at least one rsmhp module)")
+    root = Path(src) if src is not None else _default_src()
+    bad = [n for n in names if n.split(".")[0] != _PACKAGE or _locate(n, root) is None]
+    if bad:
+        raise ValueError(f"module_digest: {bad} are not {_PACKAGE} modules under {root}")
+    text = "".join(f"import {n}\n" for n in names)
+    with tempfile.TemporaryDirectory(prefix="code_digest.") as tmp:
+        script = Path(tmp) / "modules.py"
+        script.write_text(text, encoding="utf-8")
+        return describe(script, root, only)

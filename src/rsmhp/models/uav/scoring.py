@@ -55,9 +55,11 @@ from rsmhp.core.seeding import job_rng
 from rsmhp.models.uav import fused, methods, target
 from rsmhp.models.uav.methods import Method
 from rsmhp.models.uav.planner import Belief, PlanningProblem, polish
+from rsmhp.models.uav.runs import simulate_runs
 from rsmhp.models.uav.simulation import StepInfo, UAVSetup, draw_scenario, simulate_run
 from rsmhp.pipeline.contracts import Contract
 from rsmhp.pipeline.parallel import parallel_map
+from rsmhp.pipeline.runstore import RunStore
 
 __all__ = [
     "MAP_RUN_COLUMNS",
@@ -418,6 +420,7 @@ def run_map_cell(
     cell_name: str,
     seed: int,
     n_jobs: int = 1,
+    store: RunStore | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Paired closed-loop runs of every map method in one cell (runs ``0..runs-1``, the same
     scenarios and noise for every method and every cell), and the open-loop regret at the
@@ -426,18 +429,22 @@ def run_map_cell(
     eval_maxiter, n_random).
 
     A run *loses the track* when its final location error exceeds ``track_loss_error`` m.
-    Returns (one row per (method, run): :data:`MAP_RUN_COLUMNS`; open-loop regret rows:
-    :data:`REGRET_COLUMNS` with ``model`` = the cell name)."""
+    With a ``store``, closed-loop runs it holds are read, not simulated
+    (:mod:`rsmhp.models.uav.runs`). Returns (one row per (method, run):
+    :data:`MAP_RUN_COLUMNS`; open-loop regret rows: :data:`REGRET_COLUMNS` with ``model`` =
+    the cell name)."""
     cells = {c.name: c for c in map_cells(cfg)}
     if cell_name not in cells:
         raise ValueError(f"unknown map cell {cell_name!r}; cells: {', '.join(cells)}")
     cell = cells[cell_name]
     uav_cfg = merge_variant(uav, cell.variant)
+    setup = UAVSetup.from_config(uav_cfg)
     planners = methods.from_config(cfg["methods"])
     runs = list(range(int(cfg["runs"])))
-    jobs = [(uav_cfg, planners[m], seed, r) for m in planners for r in runs]
+    jobs = [(setup, planners[m], seed, r) for m in planners for r in runs]
     log.info("map cell %s (%s): %d closed-loop runs", cell.name, cell.variant, len(jobs))
-    summaries = parallel_map(_closed_loop_task, jobs, n_jobs, desc=f"cell {cell.name} runs")
+    out = simulate_runs(jobs, store, n_jobs, desc=f"cell {cell.name} runs")
+    summaries = [summary for summary, _ in out]
     loss = float(cfg["track_loss_error"])
     run_rows = [
         {
@@ -453,7 +460,6 @@ def run_map_cell(
         }
         for s in summaries
     ]
-    setup = UAVSetup.from_config(uav_cfg)
     with threadpool_limits(limits=1):
         states = belief_states(
             setup, cell.name, seed, range(int(cfg["regret_runs"])), cfg["regret_steps"]
@@ -464,12 +470,6 @@ def run_map_cell(
         pd.DataFrame(run_rows, columns=MAP_RUN_COLUMNS),
         pd.DataFrame(regret, columns=REGRET_COLUMNS),
     )
-
-
-def _closed_loop_task(job) -> dict[str, Any]:
-    uav_cfg, spec, seed, run = job
-    summary, _ = simulate_run(UAVSetup.from_config(uav_cfg), spec, seed, run)
-    return summary
 
 
 # ------------------------------------------------- model variants

@@ -275,6 +275,11 @@ def _run_workflows(plan: _Plan, envs: _Environments) -> None:
             raise _Abort("the native run failed")
     print(f"portability: emulated run in {plan.workdir}", flush=True)
     log = plan.drill_dir / "snakemake.log"
+    # compile the emulated CPU's kernels first, on every core (rsmhp.pipeline.warm): the
+    # workflow's jobs would each compile what they call, two at once compiling the same kernel
+    warm = [sys.executable, "-m", "rsmhp.pipeline.warm", "--cores", str(args.cores)]
+    if subprocess.run(warm, env=envs.emulated, check=False).returncode:
+        raise _Abort("compiling the kernels for the emulated CPU failed")
     if _snakemake(
         plan.workdir,
         envs.snakefile,

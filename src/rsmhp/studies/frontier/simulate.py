@@ -34,19 +34,20 @@ from threadpoolctl import threadpool_limits
 from rsmhp.core.seeding import job_rng
 from rsmhp.models.uav import methods
 from rsmhp.models.uav.planner import Belief
+from rsmhp.models.uav.runs import simulate_runs
 from rsmhp.models.uav.scoring import (
     REGRET_COLUMNS,
-    _closed_loop_task,
     _regret_contract,
     _score_task,
     belief_states,
     merge_variant,
     variant,
 )
-from rsmhp.models.uav.simulation import UAVSetup, simulate_run
+from rsmhp.models.uav.simulation import UAVSetup
 from rsmhp.pipeline.contracts import Contract
 from rsmhp.pipeline.parallel import parallel_map
 from rsmhp.pipeline.protocol import Configuration
+from rsmhp.pipeline.runstore import RunStore
 
 __all__ = [
     "CONFIG_RUN_COLUMNS",
@@ -129,21 +130,25 @@ def run_frontier_model(
     scoring: Mapping[str, Any],
     model: str,
     seed: int,
+    store: RunStore | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The study for one model variant (see the module docstring): ``(closed-loop rows,
     FRONTIER_RUN_COLUMNS; open-loop rows, REGRET_COLUMNS with ``model`` = the variant's
     name)``. ``uav`` is the (validated) ``uav`` section, ``models`` ``decisions.uav.models``,
     ``cfg`` the ``frontier`` section, ``scoring`` the ``decisions.uav`` section.
-    Runs on one thread: the planning times are the study's measure of compute."""
+    Runs on one thread: the planning times are the study's measure of compute. With a
+    ``store``, closed-loop runs it holds are read, not simulated (:mod:`rsmhp.models.uav.runs`),
+    and their ``plan_ms`` is the time measured by the job that computed them."""
     uav_cfg = merge_variant(uav, variant(models, model))
     planners = methods.from_config(cfg["methods"], "frontier.methods")
     runs = range(int(cfg["runs"]))
-    jobs = [(uav_cfg, planners[m], seed, r) for m in planners for r in runs]
     setup = UAVSetup.from_config(uav_cfg)
+    jobs = [(setup, planners[m], seed, r) for m in planners for r in runs]
     loss = float(cfg["track_loss_error"])
     log.info("frontier %s: %d methods x %d closed-loop runs", model, len(planners), len(runs))
-    # one worker: parallel_map runs in this process with BLAS on one thread
-    summaries = parallel_map(_closed_loop_task, jobs, 1, desc=f"frontier {model} runs")
+    # one worker: the runs are simulated in this process with BLAS on one thread
+    out = simulate_runs(jobs, store, 1, desc=f"frontier {model} runs")
+    summaries = [summary for summary, _ in out]
     run_rows = [
         {
             "model": model,
@@ -355,13 +360,6 @@ CONFIG_RUN_COLUMNS = [
 ]
 
 
-def _config_task(job) -> dict[str, Any]:
-    uav_cfg, config, seed, run = job
-    setup = config.setup(UAVSetup.from_config(uav_cfg))
-    summary, _ = simulate_run(setup, config.method, seed, run)
-    return summary
-
-
 def run_configurations(
     uav: Mapping[str, Any],
     models: list[Mapping[str, Any]],
@@ -370,18 +368,23 @@ def run_configurations(
     runs: Sequence[int],
     seed: int,
     track_loss_error: float,
+    store: RunStore | None = None,
 ) -> pd.DataFrame:
     """Paired closed-loop runs ``runs`` of every configuration on ``model`` with root seed
     ``seed`` (:data:`CONFIG_RUN_COLUMNS`; ``plan_ms`` is the run's planning wall time per
     step, measured beside whatever else ran: the protocol's times come from
-    :func:`time_configurations`). One thread; runs in configuration-major order."""
+    :func:`time_configurations`). One thread; runs in configuration-major order. With a
+    ``store``, runs it holds are read, not simulated (:mod:`rsmhp.models.uav.runs`; their
+    ``plan_ms`` is then the computing job's)."""
     uav_cfg = merge_variant(uav, variant(models, model))
     setup = UAVSetup.from_config(uav_cfg)
-    jobs = [(uav_cfg, c, seed, int(r)) for c in configs for r in runs]
+    jobs = [(c, int(r)) for c in configs for r in runs]
     log.info("%s: %d configurations x %d closed-loop runs", model, len(configs), len(runs))
-    summaries = parallel_map(_config_task, jobs, 1, desc=f"{model} runs")
+    out = simulate_runs(
+        [(c.setup(setup), c.method, seed, r) for c, r in jobs], store, 1, desc=f"{model} runs"
+    )
     rows = []
-    for (_, c, _, r), s in zip(jobs, summaries, strict=True):
+    for (c, r), (s, _) in zip(jobs, out, strict=True):
         rows.append(
             {
                 "model": model,

@@ -42,6 +42,7 @@ from rsmhp.core.seeding import job_rng
 from rsmhp.models.uav import fused, methods, target
 from rsmhp.models.uav.methods import Method
 from rsmhp.models.uav.planner import Belief, PlanningProblem
+from rsmhp.models.uav.runs import simulate_runs
 from rsmhp.models.uav.scoring import (
     _REGRET_INTEGERS,
     _REGRET_NULLABLE,
@@ -53,8 +54,9 @@ from rsmhp.models.uav.scoring import (
     score_state,
     variant,
 )
-from rsmhp.models.uav.simulation import UAVSetup, simulate_run
+from rsmhp.models.uav.simulation import UAVSetup
 from rsmhp.pipeline.contracts import Contract
+from rsmhp.pipeline.runstore import RunStore
 
 __all__ = [
     "APPROX_COLUMNS",
@@ -302,30 +304,30 @@ def run_horizon_closed(
     model: str,
     H: int,
     seed: int,
+    store: RunStore | None = None,
 ) -> pd.DataFrame:
     """Closed-loop runs ``0..closed_runs-1`` of every method of ``horizon.uav.methods`` on
     ``model`` with planning horizon ``H`` (:func:`rsmhp.models.uav.simulation.simulate_run`: the
     same scenarios and noise for every method and every H, so differences pair by run, also
-    across horizons). ``plan_ms``: planner milliseconds per step of the run (one thread)."""
+    across horizons). ``plan_ms``: planner milliseconds per step of the run (one thread). With
+    a ``store``, runs it holds are read, not simulated (:mod:`rsmhp.models.uav.runs`; their
+    ``plan_ms`` is then the computing run's)."""
     var = variant(list(models), model)
     setup = horizon_setup(uav, var, H)
     planners = _names(cfg)
-    rows = []
-    with threadpool_limits(limits=1):
-        for name, m in planners.items():
-            for r in range(int(cfg["closed_runs"])):
-                summary, _ = simulate_run(setup, m, seed, r)
-                rows.append(
-                    {
-                        "model": model,
-                        "H": int(H),
-                        "method": name,
-                        "family": m.family,
-                        "run": r,
-                        "mean_error": summary["mean_error"],
-                        "final_error": summary["final_error"],
-                        "plan_ms": 1e3 * summary["plan_seconds"] / setup.steps,
-                    }
-                )
-            log.info("horizon %s H=%d closed loop: %s done", model, H, name)
+    jobs = [(setup, m, seed, r) for m in planners.values() for r in range(int(cfg["closed_runs"]))]
+    summaries = simulate_runs(jobs, store, 1, desc=f"horizon {model} H={H} closed loop")
+    rows = [
+        {
+            "model": model,
+            "H": int(H),
+            "method": m.name,
+            "family": m.family,
+            "run": r,
+            "mean_error": summary["mean_error"],
+            "final_error": summary["final_error"],
+            "plan_ms": 1e3 * summary["plan_seconds"] / setup.steps,
+        }
+        for (_, m, _, r), (summary, _) in zip(jobs, summaries, strict=True)
+    ]
     return pd.DataFrame(rows, columns=CLOSED_COLUMNS)

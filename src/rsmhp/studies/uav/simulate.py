@@ -3,7 +3,8 @@
 Every run seeds itself from its run index (:mod:`rsmhp.models.uav.simulation`), so chunking and the
 worker count never change a number. Outputs: one summary row per run (:data:`RUN_COLUMNS`)
 and one row per (run, step) (:data:`STEP_COLUMNS`). ``plan_seconds`` is wall time and the
-only non-deterministic column.
+only non-deterministic column (with a run store, the wall time of the job that computed the
+run: :mod:`rsmhp.models.uav.runs`).
 """
 
 from __future__ import annotations
@@ -16,9 +17,11 @@ import pandas as pd
 
 from rsmhp.models.uav import methods
 from rsmhp.models.uav.methods import Method
-from rsmhp.models.uav.simulation import STEP_VALUES, UAVSetup, simulate_run
+from rsmhp.models.uav.runs import simulate_runs
+from rsmhp.models.uav.simulation import STEP_VALUES, UAVSetup
 from rsmhp.pipeline.contracts import Contract
-from rsmhp.pipeline.parallel import chunked, parallel_map
+from rsmhp.pipeline.parallel import chunked
+from rsmhp.pipeline.runstore import RunStore
 
 __all__ = [
     "NONDETERMINISTIC_COLUMNS",
@@ -114,30 +117,27 @@ def chunk_contracts(
     return run_c, step_c
 
 
-def _one_run(job: tuple[Mapping[str, Any], Method, int, int]) -> tuple[dict, list[dict]]:
-    uav, method, seed, run = job
-    summary, steps = simulate_run(UAVSetup.from_config(uav), method, seed, run)
-    for row in steps:
-        row.update(method=method.name, N_T=method.n_traj, run=run)
-    return summary, steps
-
-
 def run_chunk(
     uav: Mapping[str, Any],
     method: Method | Mapping[str, Any],
     runs: Sequence[int],
     seed: int,
     n_jobs: int = 1,
+    store: RunStore | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """Simulate ``runs`` with ``method`` (a registered :class:`rsmhp.models.uav.methods.Method` or
-    its
-    :meth:`~rsmhp.models.uav.methods.Method.spec`): (runs, steps) tables. ``uav`` needs the model
-    sections only (not ``methods``)."""
+    its :meth:`~rsmhp.models.uav.methods.Method.spec`): (runs, steps) tables. ``uav`` needs the
+    model sections only (not ``methods``). With a ``store``, runs it holds are read, not
+    simulated (:mod:`rsmhp.models.uav.runs`; ``plan_seconds`` is then the computing run's)."""
     if not isinstance(method, Method):
         method = methods.from_spec(method)
-    jobs = [(dict(uav), method, seed, int(r)) for r in runs]
+    setup = UAVSetup.from_config(uav)
+    jobs = [(setup, method, seed, int(r)) for r in runs]
     log.info("uav %s: %d runs on %d workers", method.name, len(jobs), n_jobs)
-    out = parallel_map(_one_run, jobs, n_jobs, desc=f"uav {method.name} runs")
+    out = simulate_runs(jobs, store, n_jobs, desc=f"uav {method.name} runs")
+    for (_, _, _, run), (_, steps) in zip(jobs, out, strict=True):
+        for row in steps:
+            row.update(method=method.name, N_T=method.n_traj, run=run)
     runs_df = pd.DataFrame([s for s, _ in out], columns=RUN_COLUMNS)
     steps_df = pd.DataFrame([r for _, rows in out for r in rows], columns=STEP_COLUMNS)
     return runs_df, steps_df
