@@ -108,7 +108,7 @@ $(PLUGIN_STAMP): $(STAMP) $(PLUGIN)/pyproject.toml
 	@touch $(PLUGIN_STAMP)
 
 test: lint $(PLUGIN_STAMP)
-	$(BIN)/python -m pytest tests $(PLUGIN)/tests
+	$(BIN)/python -m pytest --durations=25 tests $(PLUGIN)/tests
 
 clean:
 	rm -rf results .snakemake
