@@ -22,7 +22,7 @@ help:
 	@echo "                             numpy SIMD) elsewhere; compare with results/ and paper/claims.json"
 	@echo "  make publish               update the tracked paper/ and README results from results/paper/"
 	@echo "  make test                  set up, lint, run the test suite (what CI runs)"
-	@echo "  make setup                 create .venv, install rsmhp[dev], compile the planner kernels"
+	@echo "  make setup                 create .venv, install rsmhp[dev], compile every numba kernel (in parallel)"
 	@echo "  make lint                  ruff, ruff format --check, snakefmt --check, snakemake --lint"
 	@echo "  make clean                 delete results/ and .snakemake/"
 	@echo "Variables: CORES=$(CORES) PYTHON=$(PYTHON) VENV=$(VENV)"
