@@ -10,11 +10,14 @@ and ``make test`` run first), spread over the machine's cores.
 What is compiled, by whom (:data:`TASKS`; each task in its own process, largest first):
 
 * the planner kernel (:mod:`rsmhp.models.uav.fused`: cost, gradient and the whole planning
-  step in one compiled function, plus the covariance traces and the path): most of the time;
-* the rest: the tree search with the closed-loop step it links
-  (:mod:`rsmhp.models.uav.dpw`, :mod:`rsmhp.models.uav.stepper`), the hypotheses
-  (:mod:`rsmhp.models.uav.target`), the scrambled Sobol' points (:mod:`rsmhp.core.designs`) and
-  the LQG pruned tree (:mod:`rsmhp.models.lqg.regret`).
+  step in one compiled function, plus the covariance traces and the path) and the scrambled
+  Sobol' points (:mod:`rsmhp.core.designs`);
+* the tree search with the closed-loop step it links (:mod:`rsmhp.models.uav.dpw`,
+  :mod:`rsmhp.models.uav.stepper`), the hypotheses (:mod:`rsmhp.models.uav.target`) and the
+  LQG pruned tree (:mod:`rsmhp.models.lqg.regret`).
+
+The two take about the same time (about 22 s and 25 s of CPU on the AVX-512 machine of
+docs/performance.md), so two cores compile everything in the time of the longer.
 
 Modules whose compiled code links another module's (the tree search links the closed-loop
 step) share a task, so no kernel is compiled twice at once. A kernel that is already in the
@@ -38,12 +41,12 @@ __all__ = ["LINKED", "TASKS", "main", "warm"]
 
 #: tasks of one process each: the modules whose ``warm_up()`` it calls, in order
 TASKS: tuple[tuple[str, ...], ...] = (
-    ("rsmhp.models.uav.fused",),
+    ("rsmhp.models.uav.fused", "rsmhp.core.designs"),
     (
         "rsmhp.models.uav.dpw",
         "rsmhp.models.uav.stepper",
         "rsmhp.models.uav.target",
-        "rsmhp.core.designs",
+        # after target: both compile numba's np.partition, once per process
         "rsmhp.models.lqg.regret",
     ),
 )
