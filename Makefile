@@ -7,6 +7,18 @@ PYTHON ?= python3
 VENV ?= .venv
 CORES ?= 2
 BIN := $(VENV)/bin
+
+# EMULATE=avx2: run any target as on an x86-64 CPU with AVX2 but no AVX-512 (numba compiles
+# for znver3 with that model's own features, OpenBLAS runs its Haswell kernels, numpy's AVX-512
+# loops are off): make replicate EMULATE=avx2 (docs/performance.md#without-avx-512)
+ifeq ($(EMULATE),avx2)
+export NUMBA_CPU_NAME := znver3
+export NUMBA_CPU_FEATURES :=
+export OPENBLAS_CORETYPE := Haswell
+export NPY_DISABLE_CPU_FEATURES := X86_V4 AVX512_ICL AVX512_SPR
+else ifneq ($(EMULATE),)
+$(error EMULATE=$(EMULATE): the only emulation is avx2 (or leave EMULATE unset))
+endif
 STAMP := $(VENV)/.rsmhp-installed
 
 .PHONY: help replicate tune publish verify portability compare test lint setup clean
@@ -25,7 +37,7 @@ help:
 	@echo "  make setup                 create .venv, install rsmhp[dev], compile every numba kernel (in parallel)"
 	@echo "  make lint                  ruff, ruff format --check, snakefmt --check, snakemake --lint"
 	@echo "  make clean                 delete results/ and .snakemake/"
-	@echo "Variables: CORES=$(CORES) PYTHON=$(PYTHON) VENV=$(VENV)"
+	@echo "Variables: CORES=$(CORES) PYTHON=$(PYTHON) VENV=$(VENV) EMULATE=$(EMULATE) (avx2: as on a CPU without AVX-512)"
 	@echo "Check a config overlay:  $(BIN)/python -m rsmhp.pipeline.config my.yaml"
 	@echo "Rules and targets (snakemake --list-rules):"
 	@test -x $(BIN)/snakemake && $(BIN)/snakemake --list-rules 2>/dev/null | sed 's/^/  /' || echo "  (run make setup first)"
