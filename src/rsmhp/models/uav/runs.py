@@ -1,6 +1,8 @@
 r"""UAV closed-loop runs through the run store (:mod:`rsmhp.pipeline.runstore`): a run that
-several studies need (the UAV study, the horizon study at the base horizon, a map cell of the
-paper's model, the equal-compute study) is simulated once and read by the others.
+several rules need is simulated once and read by the others, and a rule that reruns after an
+edit outside the closed loop reads its runs. In the full config the UAV study and the map cell
+of the paper's model share 100 runs; the horizon and equal-compute studies draw from their own
+seed streams (:mod:`rsmhp.pipeline.protocol`), so none of their runs is another rule's.
 
 The key of a run
 ----------------
