@@ -73,7 +73,6 @@ import functools
 import llvmlite.binding as llvm
 import numpy as np
 from numba import njit
-from numba.core import event
 
 from rsmhp.core import boxqn, guards, numba_cache
 from rsmhp.models.uav import kernel
@@ -102,27 +101,8 @@ __all__ = [
 # floating-point reassociation: results are bit-identical to the scalar loop). Set before the
 # first compilation in the process, as numba does for its own LLVM options; it only widens
 # what LLVM may vectorise in any later compilation.
-#
-# Compile time: numba optimises a callee's code once on its own and again inside every kernel
-# that links it. With the wide limits the second pass over the *already vectorised* layouts
-# took 10-13 s (numba 0.68, znver4), so the two layouts (:func:`_value_grad_soa`,
-# :func:`_value_grad_scalar`) are compiled on their own under LLVM's default limits (not
-# vectorised: nothing calls them from Python) and vectorised once, in the kernel that links
-# them (:func:`_planner_kernel`), under the wide limits: :class:`_LayoutLimits` switches the
-# limits around the layouts' own compilations (numba's compile events). Same machine code in
-# the kernel, same bits, 28 s -> 22 s of compile CPU time.
-_WIDE_LIMITS = {"-runtime-memory-check-threshold": 512, "-vectorize-memory-check-threshold": 512}
-#: LLVM's own defaults of the same two options
-_DEFAULT_LIMITS = {"-runtime-memory-check-threshold": 8, "-vectorize-memory-check-threshold": 128}
-
-
-def _memory_check_limits(limits: dict[str, int]) -> None:
-    """Set LLVM's run-time overlap-check limits for the optimisations that follow."""
-    for option, value in limits.items():
-        llvm.set_option("rsmhp", f"{option}={value}")
-
-
-_memory_check_limits(_WIDE_LIMITS)
+llvm.set_option("rsmhp", "-runtime-memory-check-threshold=512")
+llvm.set_option("rsmhp", "-vectorize-memory-check-threshold=512")
 
 #: below this many hypotheses the planner kernel runs one hypothesis at a time
 #: (:func:`_value_grad_scalar`); from it on, vectorised over hypotheses (crossover measured by
@@ -786,26 +766,6 @@ def _traces_kernel(p0, uxy, txy, tdt, q, sens, out):  # pragma: no cover - compi
                 p, _m, _n, _x = _kalman_step(p, rxx, rxy, ryy, tdt, q, pd, limited)
                 out[c, i, j] = p[0] + p[2] + p[7] + p[9]
     return out
-
-
-class _LayoutLimits(event.Listener):
-    """Listener of numba's ``numba:compile`` events: LLVM's default overlap-check limits while
-    one of the two layouts compiles on its own (its own optimisation, when nothing vectorises
-    yet), the wide limits again when it is done (the kernel that links it vectorises it)."""
-
-    def _layout(self, ev: event.Event) -> bool:
-        return ev.data.get("dispatcher") in (_value_grad_soa, _value_grad_scalar)
-
-    def on_start(self, ev: event.Event) -> None:
-        if self._layout(ev):
-            _memory_check_limits(_DEFAULT_LIMITS)
-
-    def on_end(self, ev: event.Event) -> None:
-        if self._layout(ev):
-            _memory_check_limits(_WIDE_LIMITS)
-
-
-event.register("numba:compile", _LayoutLimits())
 
 
 # --------------------------------------------------------------------------------------------
