@@ -83,6 +83,12 @@ independence: the same planner planning again with the same seed (and other glob
 state) gives the identical result; so does a fresh planner of an equal fresh member
 (``from_spec``) after the other members and the baseline have planned; the belief and warm
 start are not modified.
+
+Closed loop (``[closed loop]``): ``closed_loop`` is one of
+:data:`rsmhp.models.uav.loop.KINDS`; :attr:`CheckReport.loop` says which loop each member's
+runs take and why (:func:`rsmhp.models.uav.loop.path`); a member on the compiled loop gives
+the Python loop's step rows bit for bit (float hex) and its summary (all but the timing) on
+two short runs.
 """
 
 from __future__ import annotations
@@ -101,12 +107,13 @@ import jsonschema
 import numpy as np
 
 from rsmhp.core.seeding import job_rng
+from rsmhp.models.uav import loop
 from rsmhp.models.uav import methods as registry
 from rsmhp.models.uav.kinematics import UAVParams, rollout
 from rsmhp.models.uav.methods import COLUMNS, Hypotheses, Method
 from rsmhp.models.uav.planner import Belief, Planner, PlannerParams, PlanResult
 from rsmhp.models.uav.sensor import SensorModel
-from rsmhp.models.uav.simulation import UAVSetup
+from rsmhp.models.uav.simulation import UAVSetup, simulate_run
 from rsmhp.models.uav.target import TargetModel
 from rsmhp.report import palette
 
@@ -137,6 +144,9 @@ class CheckReport:
     checks: tuple[str, ...]
     plan_seconds: dict[str, float] = field(default_factory=dict)
     plan_work: dict[str, int] = field(default_factory=dict)
+    #: the closed loop each member's runs take on the check's setup: ``(path, reason)`` with
+    #: path ``"compiled"`` or ``"python"`` (:func:`rsmhp.models.uav.loop.path`)
+    loop: dict[str, tuple[str, str]] = field(default_factory=dict)
 
 
 def example_setup(horizon: int = HORIZON) -> UAVSetup:
@@ -259,8 +269,50 @@ def check_method(
         if cls.estimates_cost:
             _check_hypotheses(c, m, built, setup, belief)
         seconds[m.name], work[m.name] = _check_plan(c, m, built, setup, belief)
+    loops = {m.name: _check_loop(c, m, setup) for m in built}
     names = tuple(m.name for m in built)
-    return CheckReport(cls.family, names, tuple(c.done), seconds, work)
+    return CheckReport(cls.family, names, tuple(c.done), seconds, work, loops)
+
+
+def _check_loop(c: _Checker, m: Method, setup: UAVSetup) -> tuple[str, str]:
+    """Which closed loop the member's runs take; a compiled one must give the Python loop's
+    rows bit for bit (two short runs, every column, the summary but its timing)."""
+    with c.step("closed loop", m):
+        c.that(
+            vars(type(m)).get("closed_loop", "python") in loop.KINDS,
+            "closed loop",
+            f"closed_loop must be one of {sorted(loop.KINDS)}, got {type(m).closed_loop!r}",
+            m,
+        )
+        which = loop.path(m, setup)
+        if which[0] == "compiled":
+            for run in (0, 1):
+                a = simulate_run(setup, m, 11, run, path="python")
+                b = simulate_run(setup, m, 11, run, path="compiled")
+                for ra, rb in zip(a[1], b[1], strict=True):
+                    c.that(
+                        ra.keys() == rb.keys() and all(_same(v, rb[k]) for k, v in ra.items()),
+                        "closed loop",
+                        f"run {run} step {ra['step']}: the compiled loop's row {rb} differs "
+                        f"from the Python loop's {ra}",
+                        m,
+                    )
+                sa = {k: v for k, v in a[0].items() if k != "plan_seconds"}
+                sb = {k: v for k, v in b[0].items() if k != "plan_seconds"}
+                c.that(
+                    sa == sb,
+                    "closed loop",
+                    f"run {run}: summaries differ: {sb} against the Python loop's {sa}",
+                    m,
+                )
+    return which
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Equal, floats bit for bit (their hex forms)."""
+    if isinstance(a, float) and isinstance(b, float):
+        return a.hex() == b.hex()
+    return type(a) is type(b) and a == b
 
 
 # ------------------------------------------------------------------------------ class

@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
-from rsmhp.core.seeding import canonical_job_id, job_rng, job_seed_sequence
+from rsmhp.core.seeding import canonical_job_id, job_rng, job_rngs, job_seed_sequence
 from rsmhp.studies.lqg.simulate import run_convergence, run_nbo_error
 
 
@@ -84,3 +86,23 @@ def test_different_seed_changes_results():
     a = run_convergence(BASE, seed=3)
     b = run_convergence(BASE, seed=4)
     assert not np.allclose(a["J_mhp"], b["J_mhp"])
+
+
+_VALUES = st.one_of(
+    st.integers(-(10**12), 10**12),
+    st.floats(allow_nan=False, allow_infinity=False),
+    st.text(max_size=8),
+    st.none(),
+    st.booleans(),
+    st.lists(st.integers(0, 9), max_size=3),
+)
+
+
+@settings(max_examples=60, deadline=None)
+@given(values=st.lists(_VALUES, min_size=1, max_size=5), fixed=_VALUES)
+def test_job_rngs_gives_job_rngs_streams(values, fixed) -> None:
+    """job_rngs (one id template, the value spliced in) gives job_rng's stream for every value."""
+    got = job_rngs(3, "uav_plan", "step", values, run=2, other=fixed)
+    for v, rng in zip(values, got, strict=True):
+        want = job_rng(3, "uav_plan", run=2, other=fixed, step=v)
+        assert np.array_equal(rng.integers(0, 2**63, 4), want.integers(0, 2**63, 4))

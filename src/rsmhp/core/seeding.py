@@ -17,6 +17,7 @@ from __future__ import annotations
 import hashlib
 import json
 import math
+import struct
 from collections.abc import Iterable, Iterator, Mapping
 from typing import Any
 
@@ -92,8 +93,11 @@ def _seed_sequence(root_seed: Any, job_id: str) -> np.random.SeedSequence:
     if type(root_seed) is not int or root_seed < 0:  # fast path: a plain int (every job)
         root_seed = guards.nonneg_int("root_seed", root_seed)
     digest = hashlib.blake2b(job_id.encode("utf-8"), digest_size=16).digest()
-    words = tuple(int(w) for w in np.frombuffer(digest, dtype="<u4"))
+    words = _WORDS.unpack(digest)  # four little-endian uint32 words, as Python ints
     return np.random.SeedSequence(entropy=int(root_seed), spawn_key=words)
+
+
+_WORDS = struct.Struct("<4I")
 
 
 def job_seed_sequence(root_seed: int, experiment: str, /, **params: Any) -> np.random.SeedSequence:
@@ -121,6 +125,16 @@ def job_rngs(
     if key in params:
         raise ValueError(f"{key!r} is both the varying key and a fixed parameter")
     base = {"experiment": experiment, **_params(params)}
+    # the job id's text with a marker where the varying value goes: each value's id is then
+    # one string replacement (the same text as _dump of the whole mapping, since json writes
+    # every value independently of the others)
+    marker = "\x00rsmhp-value\x00"
+    text = _dump({**base, key: marker})
+    quoted = json.dumps(marker)
+    if text.count(quoted) != 1:  # pragma: no cover - the marker cannot occur in a parameter
+        raise ValueError("job_rngs: the value marker occurs in the fixed parameters")
+    head, tail = text.split(quoted)
     for v in values:
-        seq = _seed_sequence(root_seed, _dump({**base, **_params({key: v})}))
+        value = _params({key: v})[key]
+        seq = _seed_sequence(root_seed, head + _dump(value) + tail)
         yield np.random.Generator(np.random.PCG64(seq))

@@ -72,10 +72,10 @@ import functools
 
 import llvmlite.binding as llvm
 import numpy as np
-from numba import njit
+from numba import njit, objmode
 
-from rsmhp.core import boxqn, guards, numba_cache
-from rsmhp.models.uav import kernel
+from rsmhp.core import boxqn, clock, guards, numba_cache
+from rsmhp.models.uav import kernel, stepper, target
 from rsmhp.models.uav.kinematics import UAVParams
 from rsmhp.models.uav.sensor import SensorModel
 
@@ -715,7 +715,154 @@ def _workspace(horizon, n_t, limited):  # pragma: no cover - compiled
 
 
 #: modes of :func:`_planner_kernel`
-_EVALUATE, _MINIMISE = 0, 1
+_EVALUATE, _MINIMISE, _CLOSED_LOOP = 0, 1, 2
+
+#: how the compiled closed loop gets a step's hypotheses (``loop[0][0]``):
+#: :data:`NOMINAL`, NBO's noise-free prediction computed in compiled code
+#: (:func:`rsmhp.models.uav.target.nominal`'s kernel); :data:`DRAWN`, the method's own
+#: Python generator, called once per step from compiled code (:func:`_step_hypotheses`)
+NOMINAL, DRAWN = 0, 1
+
+#: the hypothesis generators of the compiled closed loops now running, by handle (each run
+#: registers its generator for the length of its compiled call: :mod:`rsmhp.models.uav.loop`)
+HYPOTHESES: dict[int, object] = {}
+
+
+def _step_hypotheses(handle, k, uav_state, x_est, P_est):
+    """Called from the compiled closed loop (object mode) at step ``k``: the step's
+    hypotheses from the generator registered under ``handle``, as C-contiguous ``states``
+    (T, H, 4) and ``weights`` (T,)."""
+    states, weights = HYPOTHESES[int(handle)](int(k), uav_state, x_est, P_est)
+    return np.ascontiguousarray(states, dtype=float), np.ascontiguousarray(weights, dtype=float)
+
+
+@njit(cache=True)
+def _drawn(handle, k, uav, x_est, P):  # pragma: no cover - compiled
+    """:func:`_step_hypotheses` called from compiled code (object mode: the GIL is taken, the
+    arrays are passed as numpy arrays, about 2 µs per call)."""
+    with objmode(states="float64[:, :, ::1]", weights="float64[::1]"):
+        states, weights = _step_hypotheses(handle, k, uav, x_est, P)
+    return states, weights
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _entries_into(P, out):  # pragma: no cover - compiled
+    """:func:`_entries` in compiled code (same arithmetic)."""
+    for e in range(10):
+        r, c = _ROWS[e], _COLS[e]
+        out[e] = 0.5 * (P[r, c] + P[c, r])
+
+
+@njit(cache=True, inline="always", error_model="numpy")
+def _closed_loop(q, sens, maxiter, maxfun, loop):  # pragma: no cover - compiled
+    """The K steps of one closed-loop run (:func:`rsmhp.models.uav.simulation.simulate_run`
+    with a sampled-cost planner and :class:`rsmhp.models.uav.planner.BoxQN`), in the Python
+    loop's order and arithmetic: hypotheses, the weighted cost's arguments
+    (:class:`Frozen`), the optimisation from the shifted warm start and from each restart
+    start (the lowest cost wins, ties keep the earlier), the first control applied by
+    :func:`rsmhp.models.uav.stepper._advance`, the step's row. ``loop`` is built by
+    :mod:`rsmhp.models.uav.loop` (its docstring lists the arrays); outputs are written into
+    its ``vals`` (K, 16) and ``ints`` (K, 4) arrays. Returns ``(planning cycles, all
+    cycles)`` (0, 0 when the cycle counter is not used)."""
+    flags, F, Qm, ucfg, ssens, cfg0, uav, x_true, x_est, P, noise, scale, starts, vals, ints = loop
+    kind, handle, timed = flags[0], flags[1], flags[2] != 0
+    K = noise.shape[0]
+    n = scale.shape[0]
+    H = n // 2
+    n_starts = starts.shape[0] + 1
+    limited = sens[5] != 0.0
+    cfg = cfg0.copy()
+    p0 = np.empty(10)
+    warm = np.zeros(n)  # the warm start, controls (H, 2) flattened; zeros at the first step
+    x_start = np.empty(n)
+    x_try = np.empty(n)
+    x_best = np.empty(n)
+    controls = np.empty(n)
+    nominal_x0 = np.empty((1, 4))
+    nominal_w = np.zeros((1, H, 4))
+    nominal_out = np.empty((1, H, 4))
+    one = np.ones(1)
+    plan_cycles = 0
+    t_begin = clock.cycles() if timed else 0
+    for k in range(1, K + 1):
+        t0 = clock.cycles() if timed else 0
+        if kind == NOMINAL:
+            for a in range(4):
+                nominal_x0[0, a] = x_est[a]
+            states = target._propagate_kernel(nominal_x0, nominal_w, F, nominal_out)
+            weights = one
+        else:
+            states, weights = _drawn(handle, k, uav, x_est, P)
+        n_t = states.shape[0]
+        tx = np.empty((H, n_t))
+        ty = np.empty((H, n_t))
+        for i in range(n_t):
+            for j in range(H):
+                tx[j, i] = states[i, j, 0]
+                ty[j, i] = states[i, j, 1]
+        # weight_args: equal weights (or one hypothesis) -> ones and the plain average
+        equal = True
+        for i in range(1, n_t):
+            if weights[i] != weights[0]:
+                equal = False
+        if n_t == 1 or equal:
+            wts = np.ones(n_t)
+            cfg[6] = float(n_t)
+        else:
+            wts = weights.copy()
+            cfg[6] = 1.0
+        _entries_into(P, p0)
+        ws = _workspace(H, n_t, limited)
+        data = (uav, cfg, p0, q, sens, tx, ty, wts, ws, True)
+        # the warm start's optimisation, then the restarts (planner._restart)
+        f_best, f_warm = 0.0, 0.0
+        nit_total, calls, calls_best, work, status_best, winner = 0, 0, 0, 0, 0, 0
+        for r in range(n_starts):
+            if r == 0:
+                for i in range(n):
+                    x_start[i] = min(max(warm[i] / scale[i], -1.0), 1.0)
+            else:
+                for i in range(n):
+                    x_start[i] = starts[r - 1, i]
+            f, f0, nit, nfev, status = boxqn.minimise(
+                _objective, data, x_start, maxiter, maxfun, boxqn.MEMORY, boxqn.PGTOL,
+                boxqn.FTOL, x_try,
+            )  # fmt: skip
+            calls += nfev
+            work += 2 * nfev * n_t * H
+            nit_total += nit
+            if r == 0 or f < f_best:
+                f_best, status_best, winner, calls_best = f, status, r, calls
+                for i in range(n):
+                    x_best[i] = x_try[i]
+            if r == 0:
+                f_warm = f0
+        if timed:
+            plan_cycles += clock.cycles() - t0
+        for i in range(n):
+            controls[i] = x_best[i] * scale[i]
+        for i in range(n - 2):
+            warm[i] = controls[i + 2]
+        warm[n - 2] = controls[n - 2]
+        warm[n - 1] = controls[n - 1]
+        seen, err, tr = stepper._advance(
+            uav, x_true, x_est, P, controls[0:2], noise[k - 1, 0:4], noise[k - 1, 4:6],
+            noise[k - 1, 6], F, Qm, ucfg, ssens,
+        )  # fmt: skip
+        row = vals[k - 1]
+        row[0], row[1] = err, tr
+        for a in range(4):
+            row[2 + a] = uav[a]
+        row[6], row[7], row[8], row[9] = x_true[0], x_true[1], x_est[0], x_est[1]
+        row[10], row[11] = controls[0], controls[1]
+        row[12], row[13] = f_best, f_warm
+        row[14], row[15] = float(status_best), float(winner)
+        ints[k - 1, 0] = nit_total
+        ints[k - 1, 1] = calls_best
+        ints[k - 1, 2] = work
+        ints[k - 1, 3] = 1 if seen else 0
+    t_end = clock.cycles() if timed else 0
+    return plan_cycles, t_end - t_begin
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -727,20 +874,25 @@ def _objective(x, grad, data):  # pragma: no cover - compiled
 
 @njit(cache=True, nogil=True)
 def _planner_kernel(
-    mode, x, st, cfg, p0, q, sens, tx, ty, wts, want_grad, maxiter, maxfun, cost, grad, x_out
+    mode, x, st, cfg, p0, q, sens, tx, ty, wts, want_grad, maxiter, maxfun, cost, grad, x_out, loop
 ):  # pragma: no cover - compiled
     """Both compiled entry points in one function, so that the two layouts are linked into
     one kernel only. ``mode`` :data:`_EVALUATE`: :func:`_value_grad` for every row of ``x``
     (C, 2H) into ``cost`` (C,) and, if ``want_grad``, ``grad`` (C, 2H); returns zeros.
     :data:`_MINIMISE`: :func:`rsmhp.core.boxqn.minimise` of the cost from ``x[0]`` (2H,) with
     ``want_grad`` true, the final point into ``x_out`` (2H,); returns ``(f, f0, nit, nfev,
-    status)``.
+    status)``. :data:`_CLOSED_LOOP`: a whole closed-loop run (:func:`_closed_loop`, arguments
+    in ``loop``; ``q``, ``sens``, ``maxiter``, ``maxfun`` as in the other modes); returns
+    ``(planning cycles, all cycles, 0, 0, 0)``.
 
     Why one function: numba links the layouts' compiled code into every kernel that calls them
     and optimises the linked module again; for the vectorised layout that second pass took
     12-14 s per calling kernel (measured: numba 0.68, LLVM host znver4), so two calling kernels
     paid it twice. ``want_grad`` is a run-time ``bool`` in both modes (a literal ``True`` would
     make numba compile both layouts a second time, for the literal's type)."""
+    if mode == _CLOSED_LOOP:
+        c_plan, c_all = _closed_loop(q, sens, maxiter, maxfun, loop)
+        return float(c_plan), float(c_all), 0, 0, 0
     ws = _workspace(tx.shape[0], tx.shape[1], sens[5] != 0.0)
     if mode == _EVALUATE:
         for c in range(x.shape[0]):
@@ -942,6 +1094,23 @@ class Frozen:
 # the arguments :func:`_planner_kernel` does not use in a mode (the types of the used ones)
 _NO_POINT = np.empty(0)
 _NO_COST = np.empty(1)
+_NO_LOOP = (
+    np.zeros(3, dtype=np.int64),
+    np.empty((4, 4)),
+    np.empty((4, 4)),
+    (0.0,) * 6,
+    (0.0,) * 9,
+    np.empty(0),
+    np.empty(4),
+    np.empty(4),
+    np.empty(4),
+    np.empty((4, 4)),
+    np.empty((0, 7)),
+    np.empty(0),
+    np.empty((0, 0)),
+    np.empty((0, 16)),
+    np.empty((0, 4), dtype=np.int64),
+)
 
 
 def evaluate(x: np.ndarray, frozen: Frozen, want_grad: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -955,7 +1124,7 @@ def evaluate(x: np.ndarray, frozen: Frozen, want_grad: bool) -> tuple[np.ndarray
     cost_out = np.empty(n_c)
     grad_out = np.empty((n_c, x.shape[1]) if want_grad else (1, x.shape[1]))
     _planner_kernel(
-        _EVALUATE, x, *frozen.args, bool(want_grad), 0, 0, cost_out, grad_out, _NO_POINT
+        _EVALUATE, x, *frozen.args, bool(want_grad), 0, 0, cost_out, grad_out, _NO_POINT, _NO_LOOP
     )
     return cost_out, (grad_out if want_grad else np.empty((0, 0)))
 
@@ -972,7 +1141,7 @@ def minimise(
     x_out = np.empty_like(x0)
     f, f0, nit, nfev, status = _planner_kernel(
         _MINIMISE, x0[None, :], *frozen.args, True, int(maxiter), int(maxfun),
-        _NO_COST, np.empty((1, x0.size)), x_out,
+        _NO_COST, np.empty((1, x0.size)), x_out, _NO_LOOP,
     )  # fmt: skip
     return x_out, float(f), float(f0), int(nit), int(nfev), int(status)
 
@@ -1055,5 +1224,6 @@ def warm_up() -> float:
     return time.perf_counter() - t0
 
 
-# the compiled planning step inlines rsmhp.core.boxqn: numba's cache does not see edits there
-numba_cache.invalidate_if_changed(_planner_kernel, [boxqn])
+# the compiled planning step inlines rsmhp.core.boxqn: numba's cache does not see edits there,
+# and, for the closed loop, the step's kernel and the nominal hypothesis (stepper, target)
+numba_cache.invalidate_if_changed(_planner_kernel, [boxqn, clock, stepper, target])

@@ -62,9 +62,10 @@ from threadpoolctl import ThreadpoolController
 
 from rsmhp.core import guards
 from rsmhp.core.seeding import job_rng
+from rsmhp.models.uav import loop
 from rsmhp.models.uav.kinematics import UAVParams
 from rsmhp.models.uav.methods import Method
-from rsmhp.models.uav.planner import Belief, PlannerParams, shift_plan
+from rsmhp.models.uav.planner import CONVERGED, Belief, PlannerParams, shift_plan
 from rsmhp.models.uav.sensor import SensorModel
 from rsmhp.models.uav.stepper import Stepper
 from rsmhp.models.uav.target import TargetModel
@@ -198,6 +199,8 @@ def simulate_run(
     seed: int,
     run: int,
     observer: Callable[[StepInfo], None] | None = None,
+    *,
+    path: str = "auto",
 ) -> tuple[dict[str, Any], list[dict[str, Any]]]:
     """Simulate run ``run`` with ``method`` (any registered
     :class:`rsmhp.models.uav.methods.Method`;
@@ -211,6 +214,11 @@ def simulate_run(
     The arguments are checked here, once per run (``setup`` and ``method`` were checked when
     they were built); the steps of the run then call the planner, the hypothesis generators
     and the tracker with ``check=False``.
+
+    ``path``: ``"auto"`` runs the compiled closed loop where the family has one
+    (:func:`rsmhp.models.uav.loop.path`), else the Python loop; ``"python"`` always the Python
+    loop (the compiled loop's test oracle: the same rows bit for bit); ``"compiled"`` the
+    compiled loop or a ``ValueError`` saying why not.
     """
     guards.instance_of("setup", setup, UAVSetup)
     guards.instance_of("method", method, Method)
@@ -218,8 +226,16 @@ def simulate_run(
     run = guards.nonneg_int("run", run)
     if observer is not None and not callable(observer):
         raise TypeError(f"observer must be callable or None, got {type(observer).__name__}")
+    if path not in ("auto", "python", "compiled"):
+        raise ValueError(f"path must be 'auto', 'python' or 'compiled', got {path!r}")
+    compiled = False
+    if path != "python":
+        which, why = loop.path(method, setup, observer=observer is not None)
+        compiled = which == "compiled"
+        if path == "compiled" and not compiled:
+            raise ValueError(f"no compiled closed loop for {method.name}: {why}")
     with _blas().limit(limits=1):
-        return _simulate_run(setup, method, seed, run, observer)
+        return _simulate_run(setup, method, seed, run, observer, compiled)
 
 
 @functools.cache
@@ -248,7 +264,7 @@ STEP_VALUES = (
 )
 
 
-def _simulate_run(setup, method, seed, run, observer):
+def _simulate_run(setup, method, seed, run, observer, compiled):
     sc = draw_scenario(setup, seed, run)
     K, H = setup.steps, setup.planner.horizon
     w = job_rng(seed, "uav_process_noise", run=run).standard_normal((K, 4))
@@ -256,6 +272,20 @@ def _simulate_run(setup, method, seed, run, observer):
     zeta = job_rng(seed, "uav_measurement_noise", run=run).standard_normal((K, 2))
     limited = setup.sensor.limited
     det_u = job_rng(seed, "uav_detection", run=run).random(K) if limited else np.zeros(K)
+    if compiled:
+        out = loop.run(setup, method, seed, run, sc, w, zeta, det_u)
+        # contiguous copies: the Python loop's array layouts, so numpy's reductions below
+        # take the same inner loops
+        status = out.vals[:, 14].copy()
+        diagnostics = {"status": status}
+        if setup.planner.restarts:
+            diagnostics["restart"] = out.vals[:, 15].copy()
+        return _collect(
+            setup, method, seed, run, np.ascontiguousarray(out.vals[:, :14]),
+            np.ascontiguousarray(out.ints[:, :2]), out.ints[:, 2].copy(), diagnostics,
+            np.isin(status, CONVERGED).astype(float), out.ints[:, 3].astype(bool),
+            out.plan_seconds,
+        )  # fmt: skip
     x_true, uav_state = sc.target.copy(), sc.uav.copy()
     x_est, P_est = sc.estimate.astype(float), np.array(setup.P0, dtype=float)
     stepper = Stepper(setup.uav, setup.target, setup.sensor)
@@ -298,6 +328,18 @@ def _simulate_run(setup, method, seed, run, observer):
                     res.uav_path, hyp, err, tr, warm, bool(seen),
                 )
             )  # fmt: skip
+    return _collect(
+        setup, method, seed, run, vals, counts, work, diagnostics, converged, seen_k, plan_seconds
+    )
+
+
+def _collect(setup, method, seed, run, vals, counts, work, diagnostics, converged, seen_k,
+             plan_seconds):  # fmt: skip
+    """The run's (summary row, step rows) from its per-step arrays (either loop): ``vals``
+    (K, 14) :data:`STEP_VALUES`, ``counts`` (K, 2) iterations and kernel calls, ``work`` (K,),
+    ``diagnostics`` (key -> K values), ``converged`` (K,), ``seen_k`` (K,) detected."""
+    K = setup.steps
+    limited = setup.sensor.limited
     rows: list[dict[str, Any]] = []
     for k in range(K):
         row = {"step": k + 1, **dict(zip(STEP_VALUES, vals[k].tolist(), strict=True))}

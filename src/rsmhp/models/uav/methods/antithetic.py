@@ -48,6 +48,7 @@ class Antithetic(Method):
     family_label: ClassVar[str] = "antithetic"
     colour_key: ClassVar[str] = "antithetic"
     order: ClassVar[int] = 4
+    closed_loop: ClassVar[str] = "drawn"
     name_pattern: ClassVar[str] = r"antithetic_nt(\d+)"
 
     def __post_init__(self) -> None:

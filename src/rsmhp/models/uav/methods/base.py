@@ -21,6 +21,8 @@ name a family:
 ``baseline``        True for the one family every comparison is made against (NBO)
 ``estimates_cost``  False for a family that has no cost estimate of an arbitrary plan (a
                     tree search plans over simulated beliefs, not over hypotheses)
+``closed_loop``     which closed loop runs it: ``"python"`` (default), or compiled with
+                    ``"nominal"`` or ``"drawn"`` hypotheses (:mod:`rsmhp.models.uav.loop`)
 ==================  ==========================================================================
 
 and per instance: :meth:`Method.name` (rule wildcard, table key), :meth:`Method.columns` (the
@@ -132,6 +134,11 @@ class Method(ABC):
     uses_rng: ClassVar[bool] = True
     #: whether :meth:`hypotheses` gives the cost estimate of any plan (False: a tree search)
     estimates_cost: ClassVar[bool] = True
+    #: which closed loop runs the family (:mod:`rsmhp.models.uav.loop`): ``"nominal"`` (NBO's
+    #: noise-free hypothesis, computed in compiled code), ``"drawn"`` (compiled; :meth:`hypotheses`
+    #: is called from the compiled loop once per step) or ``"python"`` (the Python loop: the
+    #: default, and the only choice for a family with its own :meth:`planner`)
+    closed_loop: ClassVar[str] = "python"
 
     # ---------------------------------------------------------------- construction
     @classmethod

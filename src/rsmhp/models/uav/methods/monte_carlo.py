@@ -39,6 +39,7 @@ class MonteCarlo(Method):
     family_label: ClassVar[str] = "RS-MHP"
     colour_key: ClassVar[str] = "rsmhp"
     order: ClassVar[int] = 1
+    closed_loop: ClassVar[str] = "drawn"
     name_pattern: ClassVar[str] = r"rsmhp_nt(\d+)"
 
     def __post_init__(self) -> None:

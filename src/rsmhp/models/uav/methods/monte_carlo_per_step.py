@@ -49,6 +49,7 @@ class MonteCarloPerStep(Method):
     family_label: ClassVar[str] = "RS-MHP N_T ∝ H"
     colour_key: ClassVar[str] = "rsmhp_per_step"
     order: ClassVar[int] = 1
+    closed_loop: ClassVar[str] = "drawn"
     name_pattern: ClassVar[str] = r"rsmhp_nt(\d+)h"
     #: the tables' N_T: 0, "set by the horizon" (n_traj_at(H) hypotheses)
     n_traj: ClassVar[int] = 0

@@ -36,6 +36,7 @@ class NBO(Method):
     family_label: ClassVar[str] = "NBO"
     colour_key: ClassVar[str] = "nbo"
     order: ClassVar[int] = 0
+    closed_loop: ClassVar[str] = "nominal"
     baseline: ClassVar[bool] = True
     uses_rng: ClassVar[bool] = False
     name_pattern: ClassVar[str] = "nbo"

@@ -49,6 +49,7 @@ class PrunedTree(Method):
     family_label: ClassVar[str] = "pruned tree"
     colour_key: ClassVar[str] = "pruned"
     order: ClassVar[int] = 2
+    closed_loop: ClassVar[str] = "drawn"
     name_pattern: ClassVar[str] = r"tree_n(\d+)_m(\d+)"
 
     def __post_init__(self) -> None:

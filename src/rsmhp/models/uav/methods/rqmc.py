@@ -51,6 +51,7 @@ class RQMC(Method):
     family_label: ClassVar[str] = "RQMC"
     colour_key: ClassVar[str] = "sobol"
     order: ClassVar[int] = 3
+    closed_loop: ClassVar[str] = "drawn"
     name_pattern: ClassVar[str] = r"rqmc_nt(\d+)"
 
     def __post_init__(self) -> None:

@@ -44,6 +44,7 @@ class SigmaPoints(Method):
     family_label: ClassVar[str] = "sigma points"
     colour_key: ClassVar[str] = "cubature"
     order: ClassVar[int] = 5
+    closed_loop: ClassVar[str] = "drawn"
     uses_rng: ClassVar[bool] = False
     name_pattern: ClassVar[str] = "sigma"
     #: the tables' N_T: 0, "set by the horizon" (n_points(H) hypotheses)
