@@ -164,7 +164,8 @@ RULE_MEM = {
     "horizon_lqg_estimators", "horizon_lqg_regret", "horizon_summary", "horizon_uav",
     "horizon_uav_closed", "horizon_figures", "horizon_recording", "lqg_summary",
     "lqg_figures", "lqg_recording", "lqg_linear_cost", "horizon_optimiser",
-    "horizon_optimiser_summary", "horizon_optimiser_figures",
+    "horizon_optimiser_summary", "horizon_optimiser_figures", "horizon_uav_merge",
+    "horizon_uav_closed_merge", "horizon_optimiser_merge",
 }  # fmt: skip
 
 

@@ -6,11 +6,15 @@ from rsmhp.pipeline.code_digest import method_only
 THREADS = config["threads"]
 
 # Keys that change no number of any output: run_store only says where closed-loop runs are
-# kept (rsmhp.pipeline.runstore; jobs read it from the config, it is no rule's param). The
-# rules that record the whole config (provenance, its config sha256) get it without them,
-# so moving or disabling the store changes neither the hash `make verify` compares nor any
-# job's params.
-NUMBERS_CONFIG = {k: v for k, v in config.items() if k != "run_store"}
+# kept (rsmhp.pipeline.runstore; jobs read it from the config, it is no rule's param), split
+# how many jobs the longest simulations run as (rsmhp.pipeline.split: the merged tables are
+# the unsplit ones; only the split rules and their merges see it). The rules that record the
+# whole config (provenance, its config sha256) get it without them, so moving or disabling
+# the store, or splitting otherwise, changes neither the hash `make verify` compares nor any
+# other job's params.
+NUMBERS_CONFIG = {k: v for k, v in config.items() if k not in ("run_store", "split")}
+# jobs per unit of the split rules (config split; defaults from the schema)
+SPLIT = config["split"]
 # `--config run_store=null` arrives as the string "null" (Snakemake keeps a top-level value
 # it cannot read as a number or bool a string): it means no store, as `run_store: null` does
 if config.get("run_store") == "null":

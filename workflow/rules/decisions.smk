@@ -4,6 +4,7 @@
 from rsmhp.studies.decisions.section_lqg import FIGURES as LQG_FIGURES
 from rsmhp.studies.decisions.section_uav import FIGURES as UAV_FIGURES
 from rsmhp.models.uav.scoring import map_cells
+from rsmhp.studies.decisions.chunks import chunk_jobs, model_runs
 
 DEC = config["decisions"]
 DEC_UAV_FAMILIES = families_of(DEC["uav"]["methods"], "decisions.uav.methods")
@@ -76,29 +77,62 @@ rule decisions_lqg_summary:
         "../scripts/decisions_lqg_summary.py"
 
 
+# The UAV open-loop study runs as split.decisions_uav jobs of runs per model variant
+# (rsmhp.studies.decisions.chunks), merged into results/decisions/uav_regret.csv.
+DEC_UAV_JOBS = chunk_jobs(DEC["uav"], SPLIT["decisions_uav"])
+
+
 rule decisions_uav:
-    """Decision study, UAV open loop: every method plans at NBO belief states; plans scored on independent hypotheses."""
+    """Decision study, UAV open loop, one model variant and chunk of runs: every method plans at the runs' NBO belief states; plans scored on independent hypotheses."""
     output:
-        "results/decisions/uav_regret.csv",
+        "results/decisions/uav_regret/{model}/{chunk}.csv",
     log:
-        "results/logs/decisions_uav.log",
+        "results/logs/decisions_uav/{model}_{chunk}.log",
     benchmark:
-        "results/benchmarks/decisions_uav.tsv"
+        "results/benchmarks/decisions_uav/{model}_{chunk}.tsv"
     priority: PRIORITY["decisions_uav"]
     conda:
         ENV
     threads: THREADS
     resources:
         mem_mb=2000,
-        runtime=60,
+        runtime=30,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         cfg=canonical(DEC["uav"]),
+        # this chunk's runs (the streams are keyed on model, run and step, not on the chunk)
+        runs=lambda w: model_runs(
+            DEC["uav"]["runs"], SPLIT["decisions_uav"], int(w.chunk)
+        ),
         seed=config["seed"],
         families=DEC_UAV_FAMILIES,
         code=code_digest("workflow/scripts/decisions_uav.py", DEC_UAV_FAMILIES),
     script:
         "../scripts/decisions_uav.py"
+
+
+rule decisions_uav_merge:
+    """Decision study, UAV open loop: the jobs of every model variant checked and merged into one table."""
+    input:
+        [f"results/decisions/uav_regret/{m}/{k}.csv" for m, k in DEC_UAV_JOBS],
+    output:
+        "results/decisions/uav_regret.csv",
+    log:
+        "results/logs/decisions_uav_merge.log",
+    benchmark:
+        "results/benchmarks/decisions_uav_merge.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        cfg=canonical(DEC["uav"]),
+        jobs=SPLIT["decisions_uav"],
+        code=code_digest("workflow/scripts/decisions_uav_merge.py"),
+    script:
+        "../scripts/decisions_uav_merge.py"
 
 
 rule decisions_map_cell:

@@ -2,6 +2,8 @@
 # variance-reduction samplers, on problems with an exact J. Simulation, aggregation,
 # figures and recording are separate rules.
 
+from rsmhp.studies.estimators.chunks import ablation_chunks
+
 EST_TABLES = [
     "estimators_largest",
     "estimators_tree_vs_independent",
@@ -34,14 +36,21 @@ EST_SIM = pick(
 )
 
 
+# The ablation runs as split.estimators_ablation jobs of cells (largest first, dealt round
+# robin; rsmhp.studies.estimators.chunks), merged into results/estimators/ablation.csv.
+EST_CHUNKS = ablation_chunks(
+    EST_SIM, config["lqg"]["model"], SPLIT["estimators_ablation"]
+)
+
+
 rule estimators_ablation:
-    """Estimator study simulation: every (problem, scheme, size) cell, replicated."""
+    """Estimator study simulation, one job of cells: every (problem, scheme, size) cell of the job, replicated."""
     output:
-        "results/estimators/ablation.csv",
+        "results/estimators/ablation/{chunk}.csv",
     log:
-        "results/logs/estimators_ablation.log",
+        "results/logs/estimators_ablation/{chunk}.log",
     benchmark:
-        "results/benchmarks/estimators_ablation.tsv"
+        "results/benchmarks/estimators_ablation/{chunk}.tsv"
     priority: PRIORITY["estimators_ablation"]
     conda:
         ENV
@@ -52,10 +61,37 @@ rule estimators_ablation:
     params:
         estimators=EST_SIM,
         model=canonical(config["lqg"]["model"]),
+        # the cells follow from the grid and the job count (streams keyed on the cell)
+        jobs=SPLIT["estimators_ablation"],
         seed=config["seed"],
         code=code_digest("workflow/scripts/estimators_ablation.py"),
     script:
         "../scripts/estimators_ablation.py"
+
+
+rule estimators_ablation_merge:
+    """Estimator study: the ablation's jobs checked and merged into one table, in table order."""
+    input:
+        expand("results/estimators/ablation/{chunk}.csv", chunk=EST_CHUNKS),
+    output:
+        "results/estimators/ablation.csv",
+    log:
+        "results/logs/estimators_ablation_merge.log",
+    benchmark:
+        "results/benchmarks/estimators_ablation_merge.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=2000,
+        runtime=5,
+    params:
+        estimators=EST_SIM,
+        model=canonical(config["lqg"]["model"]),
+        jobs=SPLIT["estimators_ablation"],
+        code=code_digest("workflow/scripts/estimators_ablation_merge.py"),
+    script:
+        "../scripts/estimators_ablation_merge.py"
 
 
 rule estimators_summary:
@@ -140,7 +176,7 @@ rule estimators_recording:
 rule estimators:
     """Target: the whole estimator study."""
     input:
-        rules.estimators_ablation.output,
+        rules.estimators_ablation_merge.output,
         rules.estimators_summary.output,
         rules.estimators_figures.output,
         rules.estimators_recording.output,

@@ -10,6 +10,7 @@ from rsmhp.studies.frontier.figures import FIGURES as FRONTIER_FIGURES
 from rsmhp.studies.frontier.section import CONFIRM_TABLES
 from rsmhp.studies.frontier.section import TABLES as FRONTIER_TABLES
 from rsmhp.pipeline.protocol import Configuration, confirm_plan, tuned_configurations
+from rsmhp.studies.frontier.chunks import confirm_chunks, confirm_runs
 from rsmhp.studies.frontier.reference import (
     check_reference,
     ladder_rows,
@@ -308,26 +309,31 @@ with open(
     SUPERSEDED = json.load(_f)
 
 
+# The confirmatory runs of a model run as split.frontier_confirm jobs of contiguous runs
+# (rsmhp.studies.frontier.chunks), merged into results/frontier/confirm/{model}.csv.
 rule frontier_confirm:
-    """Protocol, confirmatory run, one model variant: closed-loop runs of the preregistered configurations on the confirm stream."""
+    """Protocol, confirmatory run, one model variant and chunk of runs: closed-loop runs of the preregistered configurations on the confirm stream."""
     output:
-        "results/frontier/confirm/{model}.csv",
+        "results/frontier/confirm/chunks/{model}/{chunk}.csv",
     log:
-        "results/logs/frontier_confirm/{model}.log",
+        "results/logs/frontier_confirm/{model}_{chunk}.log",
     benchmark:
-        "results/benchmarks/frontier_confirm/{model}.tsv"
+        "results/benchmarks/frontier_confirm/{model}_{chunk}.tsv"
     priority: PRIORITY["frontier"]
     conda:
         ENV
     threads: 1
     resources:
         mem_mb=2000,
-        runtime=120,
+        runtime=30,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         models=canonical(config["decisions"]["uav"]["models"]),
         plan=lambda w: CONFIRM["plans"][w.model],
-        runs=lambda w: CONFIRM["runs"][w.model],
+        # this chunk's runs (the streams are keyed on the run, not on the chunk)
+        runs=lambda w: confirm_runs(
+            CONFIRM["runs"][w.model], SPLIT["frontier_confirm"], int(w.chunk)
+        ),
         stream=CONFIRM["stream"] if CONFIRM is not None else None,
         track_loss_error=FRONTIER["track_loss_error"],
         seed=config["seed"],
@@ -337,6 +343,34 @@ rule frontier_confirm:
     # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
         "../scripts/frontier_confirm.py"
+
+
+rule frontier_confirm_merge:
+    """Protocol, confirmatory run, one model variant: its chunks checked and merged into the table of every configuration and run."""
+    input:
+        lambda w: expand(
+            "results/frontier/confirm/chunks/{{model}}/{chunk}.csv",
+            chunk=confirm_chunks(CONFIRM["runs"][w.model], SPLIT["frontier_confirm"]),
+        ),
+    output:
+        "results/frontier/confirm/{model}.csv",
+    log:
+        "results/logs/frontier_confirm_merge/{model}.log",
+    benchmark:
+        "results/benchmarks/frontier_confirm_merge/{model}.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        plan=lambda w: CONFIRM["plans"][w.model],
+        runs=lambda w: CONFIRM["runs"][w.model],
+        jobs=SPLIT["frontier_confirm"],
+        code=code_digest("workflow/scripts/frontier_confirm_merge.py"),
+    script:
+        "../scripts/frontier_confirm_merge.py"
 
 
 rule frontier_confirm_timing:

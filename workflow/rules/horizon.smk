@@ -8,6 +8,7 @@ from rsmhp.studies.horizon.figures_optimiser import FIGURES as OPTIMISER_FIGURES
 from rsmhp.studies.horizon.section import TABLES as HORIZON_TABLES
 from rsmhp.studies.horizon.section_optimiser import TABLES as OPTIMISER_TABLES
 from rsmhp.pipeline.protocol import stream_seed
+from rsmhp.studies.horizon.chunks import layout_runs, unit_files, units
 
 # the seed stream every job of the study draws from (horizon.stream: confirm, the stream of
 # the published verdicts; exploratory: the stream of the runs published up to 76a0c01)
@@ -49,15 +50,30 @@ wildcard_constraints:
     H=r"\d+",
 
 
+# A (model, H) unit of horizon_uav, horizon_uav_closed and horizon_optimiser runs as jobs of
+# contiguous runs (config split: the count at the largest H, fewer at shorter H;
+# rsmhp.studies.horizon.chunks); one *_merge job per rule merges every unit's chunks into
+# the unit's tables. (model, H, jobs) of every unit, in the order of HZ_JOBS / HZO_JOBS:
+HZ_UNITS = {
+    "horizon_uav": units(HZ_MODELS, HZ["H"], SPLIT["horizon_uav"], HZ["runs"]),
+    "horizon_uav_closed": units(
+        HZ_MODELS, HZ["H"], SPLIT["horizon_uav_closed"], HZ["closed_runs"]
+    ),
+    "horizon_optimiser": units(
+        HZO_MODELS, HZO["H"], SPLIT["horizon_optimiser"], HZO["runs"]
+    ),
+}
+
+
 rule horizon_uav:
-    """UAV horizon study, one model variant and horizon: cost approximation, regret and planning time of every method."""
+    """UAV horizon study, one model variant, horizon and chunk of runs: cost approximation, regret and planning time of every method at the runs' belief states."""
     output:
-        approx="results/horizon/uav/{hmodel}_H{H}_approx.csv",
-        regret="results/horizon/uav/{hmodel}_H{H}_regret.csv",
+        approx="results/horizon/uav/chunks/{hmodel}_H{H}/{chunk}_approx.csv",
+        regret="results/horizon/uav/chunks/{hmodel}_H{H}/{chunk}_regret.csv",
     log:
-        "results/logs/horizon_uav/{hmodel}_H{H}.log",
+        "results/logs/horizon_uav/{hmodel}_H{H}_{chunk}.log",
     benchmark:
-        "results/benchmarks/horizon_uav/{hmodel}_H{H}.tsv"
+        "results/benchmarks/horizon_uav/{hmodel}_H{H}_{chunk}.tsv"
     priority: PRIORITY["horizon_uav"]
     conda:
         ENV
@@ -70,6 +86,10 @@ rule horizon_uav:
         models=canonical(config["decisions"]["uav"]["models"]),
         cfg=pick(HZ, "runs", "steps", "plans", "n_ref", "replicates", "methods"),
         scoring=DEC_SCORING,
+        # this chunk's runs (the streams are keyed on the run, not on the chunk)
+        runs=lambda w: layout_runs(
+            HZ_UNITS["horizon_uav"], HZ["runs"], w.hmodel, w.H, int(w.chunk)
+        ),
         seed=HZ_SEED,
         families=HZ_FAMILIES,
         code=code_digest("workflow/scripts/horizon_uav.py", HZ_FAMILIES),
@@ -77,14 +97,46 @@ rule horizon_uav:
         "../scripts/horizon_uav.py"
 
 
-rule horizon_uav_closed:
-    """UAV horizon study, one model variant and horizon: paired closed-loop runs of every method."""
+rule horizon_uav_merge:
+    """UAV horizon study: the chunks of every model variant and horizon checked and merged into their cost-approximation and regret tables."""
+    input:
+        approx=unit_files(
+            "results/horizon/uav/chunks/{hmodel}_H{H}/{chunk}_approx.csv",
+            HZ_UNITS["horizon_uav"],
+        ),
+        regret=unit_files(
+            "results/horizon/uav/chunks/{hmodel}_H{H}/{chunk}_regret.csv",
+            HZ_UNITS["horizon_uav"],
+        ),
     output:
-        "results/horizon/uav/{hmodel}_H{H}_closed.csv",
+        approx=expand("results/horizon/uav/{job}_approx.csv", job=HZ_JOBS),
+        regret=expand("results/horizon/uav/{job}_regret.csv", job=HZ_JOBS),
     log:
-        "results/logs/horizon_uav_closed/{hmodel}_H{H}.log",
+        "results/logs/horizon_uav_merge.log",
     benchmark:
-        "results/benchmarks/horizon_uav_closed/{hmodel}_H{H}.tsv"
+        "results/benchmarks/horizon_uav_merge.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        cfg=pick(HZ, "runs", "steps", "plans", "replicates", "methods"),
+        units=HZ_UNITS["horizon_uav"],
+        code=code_digest("workflow/scripts/horizon_uav_merge.py"),
+    script:
+        "../scripts/horizon_uav_merge.py"
+
+
+rule horizon_uav_closed:
+    """UAV horizon study, one model variant, horizon and chunk of runs: paired closed-loop runs of every method."""
+    output:
+        "results/horizon/uav/chunks/{hmodel}_H{H}/{chunk}_closed.csv",
+    log:
+        "results/logs/horizon_uav_closed/{hmodel}_H{H}_{chunk}.log",
+    benchmark:
+        "results/benchmarks/horizon_uav_closed/{hmodel}_H{H}_{chunk}.tsv"
     priority: PRIORITY["horizon_uav"]
     conda:
         ENV
@@ -96,6 +148,14 @@ rule horizon_uav_closed:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         models=canonical(config["decisions"]["uav"]["models"]),
         cfg=pick(HZ, "closed_runs", "methods"),
+        # this chunk's closed-loop runs (keyed on the run, not on the chunk)
+        runs=lambda w: layout_runs(
+            HZ_UNITS["horizon_uav_closed"],
+            HZ["closed_runs"],
+            w.hmodel,
+            w.H,
+            int(w.chunk),
+        ),
         seed=HZ_SEED,
         families=HZ_FAMILIES,
         code=code_digest("workflow/scripts/horizon_uav_closed.py", HZ_FAMILIES),
@@ -103,6 +163,33 @@ rule horizon_uav_closed:
     # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
         "../scripts/horizon_uav_closed.py"
+
+
+rule horizon_uav_closed_merge:
+    """UAV horizon study: the closed-loop chunks of every model variant and horizon checked and merged into one table each."""
+    input:
+        unit_files(
+            "results/horizon/uav/chunks/{hmodel}_H{H}/{chunk}_closed.csv",
+            HZ_UNITS["horizon_uav_closed"],
+        ),
+    output:
+        expand("results/horizon/uav/{job}_closed.csv", job=HZ_JOBS),
+    log:
+        "results/logs/horizon_uav_closed_merge.log",
+    benchmark:
+        "results/benchmarks/horizon_uav_closed_merge.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        cfg=pick(HZ, "closed_runs", "methods"),
+        units=HZ_UNITS["horizon_uav_closed"],
+        code=code_digest("workflow/scripts/horizon_uav_closed_merge.py"),
+    script:
+        "../scripts/horizon_uav_closed_merge.py"
 
 
 rule horizon_lqg_estimators:
@@ -247,30 +334,61 @@ rule horizon_recording:
 
 
 rule horizon_optimiser:
-    """Optimiser split, one model variant and horizon: every method's plan under each optimiser budget, the near-global minimiser of its own cost, the regret split into approximation and optimisation parts."""
+    """Optimiser split, one model variant, horizon and chunk of runs: every method's plan under each optimiser budget, the near-global minimiser of its own cost, the regret split into approximation and optimisation parts."""
     output:
-        "results/horizon/optimiser/{hmodel}_H{H}.csv",
+        "results/horizon/optimiser/chunks/{hmodel}_H{H}/{chunk}.csv",
     log:
-        "results/logs/horizon_optimiser/{hmodel}_H{H}.log",
+        "results/logs/horizon_optimiser/{hmodel}_H{H}_{chunk}.log",
     benchmark:
-        "results/benchmarks/horizon_optimiser/{hmodel}_H{H}.tsv"
+        "results/benchmarks/horizon_optimiser/{hmodel}_H{H}_{chunk}.tsv"
     priority: PRIORITY["horizon_uav"]
     conda:
         ENV
     threads: 1
     resources:
         mem_mb=2000,
-        runtime=120,
+        runtime=60,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         model=lambda wc: HZ_VARIANTS[wc.hmodel],
         cfg=pick(HZO, *HZO_KEYS),
         scoring=pick(DEC["uav"], "n_eval", "polish", "random_starts"),
+        # this chunk's runs (the streams are keyed on the run, not on the chunk)
+        runs=lambda w: layout_runs(
+            HZ_UNITS["horizon_optimiser"], HZO["runs"], w.hmodel, w.H, int(w.chunk)
+        ),
         seed=HZ_SEED,
         families=HZO_FAMILIES,
         code=code_digest("workflow/scripts/horizon_optimiser.py", HZO_FAMILIES),
     script:
         "../scripts/horizon_optimiser.py"
+
+
+rule horizon_optimiser_merge:
+    """Optimiser split: the chunks of every model variant and horizon checked and merged into one table each."""
+    input:
+        unit_files(
+            "results/horizon/optimiser/chunks/{hmodel}_H{H}/{chunk}.csv",
+            HZ_UNITS["horizon_optimiser"],
+        ),
+    output:
+        expand("results/horizon/optimiser/{job}.csv", job=HZO_JOBS),
+    log:
+        "results/logs/horizon_optimiser_merge.log",
+    benchmark:
+        "results/benchmarks/horizon_optimiser_merge.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=1000,
+        runtime=5,
+    params:
+        cfg=pick(HZO, *HZO_KEYS),
+        units=HZ_UNITS["horizon_optimiser"],
+        code=code_digest("workflow/scripts/horizon_optimiser_merge.py"),
+    script:
+        "../scripts/horizon_optimiser_merge.py"
 
 
 rule horizon_optimiser_summary:

@@ -1,11 +1,13 @@
-"""Rule decisions_uav: open-loop regret of every method's plan at belief states."""
+"""Rule decisions_uav: open-loop regret of every method's plan at the belief states of one
+model variant and chunk of runs."""
 
-from rsmhp.models.uav.scoring import run_uav_regret
 from rsmhp.pipeline.io import write_csv
 from rsmhp.pipeline.script import rule_logging
+from rsmhp.studies.decisions.chunks import run_regret_chunk
 
 with rule_logging(snakemake):
-    df = run_uav_regret(
-        snakemake.params.uav, snakemake.params.cfg, snakemake.params.seed, snakemake.threads
+    p = snakemake.params
+    df = run_regret_chunk(
+        p.uav, p.cfg, snakemake.wildcards.model, p.runs, p.seed, snakemake.threads
     )
     write_csv(df, snakemake.output[0])

@@ -1,5 +1,5 @@
 """Rule frontier_confirm: closed-loop runs of the preregistered configurations on one model
-variant, on the confirmatory stream."""
+variant and one chunk of its runs, on the confirmatory stream."""
 
 from rsmhp.pipeline.io import write_csv
 from rsmhp.pipeline.protocol import Configuration, stream_seed
@@ -16,7 +16,7 @@ with rule_logging(snakemake) as log:
         p.models,
         snakemake.wildcards.model,
         configs,
-        range(int(p.runs)),
+        p.runs,
         stream_seed(p.seed, p.stream),
         p.track_loss_error,
         store,

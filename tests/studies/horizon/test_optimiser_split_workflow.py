@@ -1,12 +1,13 @@
-"""The optimiser split in the workflow: rules horizon_optimiser, horizon_optimiser_summary and
-horizon_optimiser_figures, the config section horizon.optimiser, the report section and the
-figure, and what the long-horizon section and HZ-3 say about the regret they show.
+"""The optimiser split in the workflow: rules horizon_optimiser (jobs of runs per model and
+H), horizon_optimiser_merge, horizon_optimiser_summary and horizon_optimiser_figures, the
+config section horizon.optimiser, the report section and the figure, and what the
+long-horizon section and HZ-3 say about the regret they show.
 
 Oracles: every number of the section body is recomputed here from the split rows (means by
 hand, the ranges over methods, the shares of plans at 0 iterations and converged) and must
 appear in the text; the summary's extra column is the share counted by hand; bad config values
-are refused naming the field; the tiny workflow lists one job per (model, H) and its run
-writes tables that meet their contracts and a section whose numbers are the summary's.
+are refused naming the field; the tiny workflow lists the configured jobs per (model, H) and
+its run writes tables that meet their contracts and a section whose numbers are the summary's.
 """
 
 from __future__ import annotations
@@ -26,6 +27,7 @@ from rsmhp.pipeline.config import ConfigError, check_config
 from rsmhp.pipeline.contracts import read_checked
 from rsmhp.report.figures import save_figure
 from rsmhp.report.markdown import fmt, range_text
+from rsmhp.studies.horizon.chunks import units
 from rsmhp.studies.horizon.claims import _hz3, budget_text
 from rsmhp.studies.horizon.figures_optimiser import budget_label, largest_budget, optimiser_figure
 from rsmhp.studies.horizon.section_optimiser import (
@@ -314,14 +316,18 @@ def _snakemake(workdir: Path, option: str, *targets: str):
 
 
 @pytest.mark.workflow
-def test_dry_run_lists_one_job_per_model_and_horizon(tmp_path):
+def test_dry_run_lists_the_jobs_of_every_model_and_horizon(tmp_path):
     tiny = yaml.safe_load(TINY.read_text())
     res = _snakemake(tmp_path, "-n", "all")
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-3000:]
     stats = dict(re.findall(r"^(\w+)\s+(\d+)$", out.split("Job stats:", 1)[1], flags=re.M))
-    jobs = len(tiny["horizon"]["uav"]["models"]) * len(tiny["horizon"]["optimiser"]["H"])
-    assert stats["horizon_optimiser"] == str(jobs)
+    # split.horizon_optimiser jobs of runs per (model, H) at the largest H, fewer below
+    opt = tiny["horizon"]["optimiser"]
+    layout = units(tiny["horizon"]["uav"]["models"], opt["H"], tiny["split"][RULE], opt["runs"])
+    assert len(layout) == len(tiny["horizon"]["uav"]["models"]) * len(opt["H"])
+    assert stats["horizon_optimiser"] == str(sum(j for *_, j in layout))
+    assert stats["horizon_optimiser_merge"] == "1"  # every (model, H) table in one job
     assert stats["horizon_optimiser_summary"] == stats["horizon_optimiser_figures"] == "1"
     for h in tiny["horizon"]["optimiser"]["H"]:
         assert f"results/horizon/optimiser/paper_H{h}.csv" in out

@@ -53,11 +53,15 @@ __all__ = [
     "CELL",
     "SUMMARY_COLUMNS",
     "GridPoint",
+    "ablation_contract",
     "build_problem",
+    "by_weight",
     "grid_points",
     "n_trajectories",
+    "point_weight",
     "run_ablation",
     "run_points",
+    "sort_ablation",
     "summarize_ablation",
 ]
 
@@ -353,6 +357,30 @@ def _task(job) -> list[dict]:
     return out
 
 
+def point_weight(point: GridPoint, prob: LinearQuadratic) -> int:
+    """A rough size of the work of one grid point: trajectories or leaves times H times the
+    squared state dimension (the matrix products of a step); what :func:`by_weight` orders
+    by. Only the order in which cells are computed depends on it, never a number."""
+    size = point.N**prob.H if point.M == 0 else point.N * point.M
+    return max(point.n, size, 1) * prob.H * prob.d**2
+
+
+def by_weight(points: list[GridPoint], problems: Mapping[str, LinearQuadratic]) -> list[GridPoint]:
+    """``points``, largest :func:`point_weight` first (ties in grid order)."""
+    return sorted(points, key=lambda p: -point_weight(p, problems[p.problem]))
+
+
+def sort_ablation(df: pd.DataFrame, problem_order: list[str]) -> pd.DataFrame:
+    """The ablation rows in table order: problems in ``problem_order`` (the config's), then
+    scheme, weighting, N, M, trajectories and replicate (one row per key)."""
+    order = {name: i for i, name in enumerate(problem_order)}
+    df = df.assign(_p=df["problem"].map(order))
+    df = df.sort_values(
+        ["_p", "scheme", "weighting", "N", "M", "n_trajectories", "replicate"], kind="stable"
+    )
+    return df.drop(columns="_p").reset_index(drop=True)
+
+
 def run_points(
     points: list[GridPoint],
     specs: Mapping[str, Mapping[str, Any]],
@@ -367,14 +395,7 @@ def run_points(
     config entries. The largest cells go first, dealt round-robin into ``4 n_jobs`` tasks:
     rows never depend on it (each cell's streams are keyed on the cell)."""
     problems = {name: build_problem(spec, lqg_model) for name, spec in specs.items()}
-    weight = {
-        p: (
-            max(p.n, p.N ** problems[p.problem].H if p.M == 0 else p.N * p.M, 1)
-            * problems[p.problem].H
-        )
-        for p in points
-    }
-    ordered = sorted(points, key=lambda p: -weight[p])
+    ordered = by_weight(points, problems)
     n_tasks = max(1, min(len(points), 4 * n_jobs))
     jobs = [(ordered[i::n_tasks], specs, dict(lqg_model), seed, reps) for i in range(n_tasks)]
     log.info(
@@ -400,12 +421,7 @@ def run_ablation(
     problems = {name: build_problem(spec, lqg_model) for name, spec in specs.items()}
     points = grid_points(cfg, problems)
     df = run_points(points, specs, lqg_model, seed, int(cfg["replicates"]), n_jobs)
-    order = {name: i for i, name in enumerate(specs)}
-    df = df.assign(_p=df["problem"].map(order))
-    df = df.sort_values(
-        ["_p", "scheme", "weighting", "N", "M", "n_trajectories", "replicate"], kind="stable"
-    )
-    return df.drop(columns="_p").reset_index(drop=True)
+    return sort_ablation(df, list(specs))
 
 
 # ------------------------------------------------------------------ per-cell summary

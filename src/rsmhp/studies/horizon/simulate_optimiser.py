@@ -381,13 +381,16 @@ def run_optimiser_split(
     cfg: Mapping[str, Any],
     scoring: Mapping[str, Any],
     seed: int,
+    runs: Sequence[int] | None = None,
 ) -> pd.DataFrame:
     """The split (module docstring) for one model variant (an entry of
     ``decisions.uav.models``: ``name`` and overrides) at horizon ``H``: one row per (run,
     step, method with an own cost, budget), :data:`SPLIT_COLUMNS`. ``uav`` is the validated
     ``uav`` section; ``cfg`` has ``runs``, ``steps``, ``methods``, ``budgets``,
     ``polish_starts``, ``polish_maxiter``; ``scoring`` has ``n_eval``, ``polish`` and
-    ``random_starts`` (the decision study's). Runs on one BLAS thread."""
+    ``random_starts`` (the decision study's). Runs on one BLAS thread. ``runs``: the belief
+    states of these runs only (default ``0..runs-1``; a chunk job's rows are the unsplit
+    job's rows of its runs, :mod:`rsmhp.studies.horizon.chunks`)."""
     model = str(model_variant["name"])
     H = guards.positive_int("H", H)
     base = horizon_setup(uav, model_variant, int(uav["planner"]["horizon"]))
@@ -396,7 +399,8 @@ def run_optimiser_split(
     budgets(cfg)  # refuse a bad budget list before any work
     rows: list[dict[str, Any]] = []
     with threadpool_limits(limits=1):
-        states = belief_states(base, model, seed, range(int(cfg["runs"])), cfg["steps"])
+        runs = range(int(cfg["runs"])) if runs is None else [int(r) for r in runs]
+        states = belief_states(base, model, seed, runs, cfg["steps"])
         log.info("optimiser split %s H=%d: %d states x %d methods x %d budgets", model, H,
                  len(states), len(planners), len(cfg["budgets"]))  # fmt: skip
         for i, st in enumerate(states):

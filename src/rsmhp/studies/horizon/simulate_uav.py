@@ -252,17 +252,21 @@ def run_horizon(
     model: str,
     H: int,
     seed: int,
+    runs: Sequence[int] | None = None,
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The study for (``model``, ``H``) (module docstring): ``(cost-approximation rows,
     APPROX_COLUMNS; regret rows, HORIZON_REGRET_COLUMNS)``. ``uav`` is the validated ``uav``
     section, ``models`` ``decisions.uav.models``, ``cfg`` the ``horizon`` section,
-    ``scoring`` the decision study's scoring settings. Runs on one thread."""
+    ``scoring`` the decision study's scoring settings. Runs on one thread. ``runs``: the
+    belief states of these runs only (default ``0..runs-1``; a chunk job's rows are the
+    unsplit job's rows of its runs, :mod:`rsmhp.studies.horizon.chunks`)."""
     var = variant(list(models), model)
     base = horizon_setup(uav, var, int(uav["planner"]["horizon"]))
     setup = horizon_setup(uav, var, H)
     planners = _names(cfg)
+    runs = range(int(cfg["runs"])) if runs is None else [int(r) for r in runs]
     with threadpool_limits(limits=1):
-        states = belief_states(base, model, seed, range(int(cfg["runs"])), cfg["steps"])
+        states = belief_states(base, model, seed, runs, cfg["steps"])
         log.info("horizon %s H=%d: %d belief states x %d methods", model, H, len(states),
                  len(planners))  # fmt: skip
         approx, regret = [], []
@@ -305,17 +309,20 @@ def run_horizon_closed(
     H: int,
     seed: int,
     store: RunStore | None = None,
+    runs: Sequence[int] | None = None,
 ) -> pd.DataFrame:
-    """Closed-loop runs ``0..closed_runs-1`` of every method of ``horizon.uav.methods`` on
-    ``model`` with planning horizon ``H`` (:func:`rsmhp.models.uav.simulation.simulate_run`: the
-    same scenarios and noise for every method and every H, so differences pair by run, also
-    across horizons). ``plan_ms``: planner milliseconds per step of the run (one thread). With
-    a ``store``, runs it holds are read, not simulated (:mod:`rsmhp.models.uav.runs`; their
-    ``plan_ms`` is then the computing run's)."""
+    """Closed-loop runs ``0..closed_runs-1`` (or ``runs``: a chunk job's) of every method of
+    ``horizon.uav.methods`` on ``model`` with planning horizon ``H``
+    (:func:`rsmhp.models.uav.simulation.simulate_run`: the same scenarios and noise for every
+    method and every H, so differences pair by run, also across horizons), method-major.
+    ``plan_ms``: planner milliseconds per step of the run (one thread). With a ``store``, runs
+    it holds are read, not simulated (:mod:`rsmhp.models.uav.runs`; their ``plan_ms`` is then
+    the computing run's)."""
     var = variant(list(models), model)
     setup = horizon_setup(uav, var, H)
     planners = _names(cfg)
-    jobs = [(setup, m, seed, r) for m in planners.values() for r in range(int(cfg["closed_runs"]))]
+    runs = range(int(cfg["closed_runs"])) if runs is None else [int(r) for r in runs]
+    jobs = [(setup, m, seed, r) for m in planners.values() for r in runs]
     summaries = simulate_runs(jobs, store, 1, desc=f"horizon {model} H={H} closed loop")
     rows = [
         {
