@@ -745,124 +745,75 @@ def _drawn(handle, k, uav, x_est, P):  # pragma: no cover - compiled
     return states, weights
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _entries_into(P, out):  # pragma: no cover - compiled
-    """:func:`_entries` in compiled code (same arithmetic)."""
+@njit(cache=True, nogil=True, error_model="numpy")
+def _loop_plan_data(k, loop, cfg, p0, H):  # pragma: no cover - compiled
+    """Step ``k`` of the compiled closed loop, before the optimisation: the hypotheses
+    (:data:`NOMINAL` or :data:`DRAWN`), their coordinates ``(tx, ty)`` (H, T), the weights and
+    the divisor (``cfg[6]``) as :func:`weight_args` gives them, and the covariance's entries
+    into ``p0``: the arguments :class:`Frozen` builds in the Python loop."""
+    flags, F, _Q, _u, _s, _c, uav, _xt, x_est, P, _n, _sc, _st, _v, _i = loop
+    if flags[0] == NOMINAL:
+        x0 = np.empty((1, 4))
+        for a in range(4):
+            x0[0, a] = x_est[a]
+        states = target._propagate_kernel(x0, np.zeros((1, H, 4)), F, np.empty((1, H, 4)))
+        weights = np.ones(1)
+    else:
+        states, weights = _drawn(flags[1], k, uav, x_est, P)
+    n_t = states.shape[0]
+    tx = np.empty((H, n_t))
+    ty = np.empty((H, n_t))
+    for i in range(n_t):
+        for j in range(H):
+            tx[j, i] = states[i, j, 0]
+            ty[j, i] = states[i, j, 1]
+    equal = True
+    for i in range(1, n_t):
+        if weights[i] != weights[0]:
+            equal = False
+    if equal:  # equal weights (or one hypothesis): ones and the plain average
+        wts = np.ones(n_t)
+        cfg[6] = float(n_t)
+    else:
+        wts = weights.copy()
+        cfg[6] = 1.0
     for e in range(10):
         r, c = _ROWS[e], _COLS[e]
-        out[e] = 0.5 * (P[r, c] + P[c, r])
+        p0[e] = 0.5 * (P[r, c] + P[c, r])
+    return tx, ty, wts
 
 
-@njit(cache=True, inline="always", error_model="numpy")
-def _closed_loop(q, sens, maxiter, maxfun, loop):  # pragma: no cover - compiled
-    """The K steps of one closed-loop run (:func:`rsmhp.models.uav.simulation.simulate_run`
-    with a sampled-cost planner and :class:`rsmhp.models.uav.planner.BoxQN`), in the Python
-    loop's order and arithmetic: hypotheses, the weighted cost's arguments
-    (:class:`Frozen`), the optimisation from the shifted warm start and from each restart
-    start (the lowest cost wins, ties keep the earlier), the first control applied by
-    :func:`rsmhp.models.uav.stepper._advance`, the step's row. ``loop`` is built by
-    :mod:`rsmhp.models.uav.loop` (its docstring lists the arrays); outputs are written into
-    its ``vals`` (K, 16) and ``ints`` (K, 4) arrays. Returns ``(planning cycles, all
-    cycles)`` (0, 0 when the cycle counter is not used)."""
-    flags, F, Qm, ucfg, ssens, cfg0, uav, x_true, x_est, P, noise, scale, starts, vals, ints = loop
-    kind, handle, timed = flags[0], flags[1], flags[2] != 0
-    K = noise.shape[0]
+@njit(cache=True, nogil=True, error_model="numpy")
+def _loop_step(k, loop, x_best, warm, plan):  # pragma: no cover - compiled
+    """Step ``k`` of the compiled closed loop, after the optimisation: the controls of the
+    winning plan ``x_best``, the next warm start (``shift_plan``), the first control applied by
+    :func:`rsmhp.models.uav.stepper._advance` and the step's row (``plan``: cost, warm cost,
+    status, winning start, iterations, kernel calls, work)."""
+    _f, F, Qm, ucfg, ssens, _c, uav, x_true, x_est, P, noise, scale, _st, vals, ints = loop
     n = scale.shape[0]
-    H = n // 2
-    n_starts = starts.shape[0] + 1
-    limited = sens[5] != 0.0
-    cfg = cfg0.copy()
-    p0 = np.empty(10)
-    warm = np.zeros(n)  # the warm start, controls (H, 2) flattened; zeros at the first step
-    x_start = np.empty(n)
-    x_try = np.empty(n)
-    x_best = np.empty(n)
     controls = np.empty(n)
-    nominal_x0 = np.empty((1, 4))
-    nominal_w = np.zeros((1, H, 4))
-    nominal_out = np.empty((1, H, 4))
-    one = np.ones(1)
-    plan_cycles = 0
-    t_begin = clock.cycles() if timed else 0
-    for k in range(1, K + 1):
-        t0 = clock.cycles() if timed else 0
-        if kind == NOMINAL:
-            for a in range(4):
-                nominal_x0[0, a] = x_est[a]
-            states = target._propagate_kernel(nominal_x0, nominal_w, F, nominal_out)
-            weights = one
-        else:
-            states, weights = _drawn(handle, k, uav, x_est, P)
-        n_t = states.shape[0]
-        tx = np.empty((H, n_t))
-        ty = np.empty((H, n_t))
-        for i in range(n_t):
-            for j in range(H):
-                tx[j, i] = states[i, j, 0]
-                ty[j, i] = states[i, j, 1]
-        # weight_args: equal weights (or one hypothesis) -> ones and the plain average
-        equal = True
-        for i in range(1, n_t):
-            if weights[i] != weights[0]:
-                equal = False
-        if n_t == 1 or equal:
-            wts = np.ones(n_t)
-            cfg[6] = float(n_t)
-        else:
-            wts = weights.copy()
-            cfg[6] = 1.0
-        _entries_into(P, p0)
-        ws = _workspace(H, n_t, limited)
-        data = (uav, cfg, p0, q, sens, tx, ty, wts, ws, True)
-        # the warm start's optimisation, then the restarts (planner._restart)
-        f_best, f_warm = 0.0, 0.0
-        nit_total, calls, calls_best, work, status_best, winner = 0, 0, 0, 0, 0, 0
-        for r in range(n_starts):
-            if r == 0:
-                for i in range(n):
-                    x_start[i] = min(max(warm[i] / scale[i], -1.0), 1.0)
-            else:
-                for i in range(n):
-                    x_start[i] = starts[r - 1, i]
-            f, f0, nit, nfev, status = boxqn.minimise(
-                _objective, data, x_start, maxiter, maxfun, boxqn.MEMORY, boxqn.PGTOL,
-                boxqn.FTOL, x_try,
-            )  # fmt: skip
-            calls += nfev
-            work += 2 * nfev * n_t * H
-            nit_total += nit
-            if r == 0 or f < f_best:
-                f_best, status_best, winner, calls_best = f, status, r, calls
-                for i in range(n):
-                    x_best[i] = x_try[i]
-            if r == 0:
-                f_warm = f0
-        if timed:
-            plan_cycles += clock.cycles() - t0
-        for i in range(n):
-            controls[i] = x_best[i] * scale[i]
-        for i in range(n - 2):
-            warm[i] = controls[i + 2]
-        warm[n - 2] = controls[n - 2]
-        warm[n - 1] = controls[n - 1]
-        seen, err, tr = stepper._advance(
-            uav, x_true, x_est, P, controls[0:2], noise[k - 1, 0:4], noise[k - 1, 4:6],
-            noise[k - 1, 6], F, Qm, ucfg, ssens,
-        )  # fmt: skip
-        row = vals[k - 1]
-        row[0], row[1] = err, tr
-        for a in range(4):
-            row[2 + a] = uav[a]
-        row[6], row[7], row[8], row[9] = x_true[0], x_true[1], x_est[0], x_est[1]
-        row[10], row[11] = controls[0], controls[1]
-        row[12], row[13] = f_best, f_warm
-        row[14], row[15] = float(status_best), float(winner)
-        ints[k - 1, 0] = nit_total
-        ints[k - 1, 1] = calls_best
-        ints[k - 1, 2] = work
-        ints[k - 1, 3] = 1 if seen else 0
-    t_end = clock.cycles() if timed else 0
-    return plan_cycles, t_end - t_begin
+    for i in range(n):
+        controls[i] = x_best[i] * scale[i]
+    for i in range(n - 2):
+        warm[i] = controls[i + 2]
+    warm[n - 2] = controls[n - 2]
+    warm[n - 1] = controls[n - 1]
+    seen, err, tr = stepper._advance(
+        uav, x_true, x_est, P, controls[0:2], noise[k - 1, 0:4], noise[k - 1, 4:6],
+        noise[k - 1, 6], F, Qm, ucfg, ssens,
+    )  # fmt: skip
+    f_best, f_warm, status, winner, nit, calls, work = plan
+    row = vals[k - 1]
+    row[0], row[1] = err, tr
+    for a in range(4):
+        row[2 + a] = uav[a]
+    row[6], row[7], row[8], row[9] = x_true[0], x_true[1], x_est[0], x_est[1]
+    row[10], row[11] = controls[0], controls[1]
+    row[12], row[13], row[14], row[15] = f_best, f_warm, float(status), float(winner)
+    ints[k - 1, 0] = nit
+    ints[k - 1, 1] = calls
+    ints[k - 1, 2] = work
+    ints[k - 1, 3] = 1 if seen else 0
 
 
 @njit(cache=True, inline="always", error_model="numpy")
@@ -881,28 +832,84 @@ def _planner_kernel(
     (C, 2H) into ``cost`` (C,) and, if ``want_grad``, ``grad`` (C, 2H); returns zeros.
     :data:`_MINIMISE`: :func:`rsmhp.core.boxqn.minimise` of the cost from ``x[0]`` (2H,) with
     ``want_grad`` true, the final point into ``x_out`` (2H,); returns ``(f, f0, nit, nfev,
-    status)``. :data:`_CLOSED_LOOP`: a whole closed-loop run (:func:`_closed_loop`, arguments
-    in ``loop``; ``q``, ``sens``, ``maxiter``, ``maxfun`` as in the other modes); returns
-    ``(planning cycles, all cycles, 0, 0, 0)``.
+    status)``. :data:`_CLOSED_LOOP`: a whole closed-loop run of K steps
+    (:mod:`rsmhp.models.uav.loop`: its arguments in ``loop``; ``q``, ``sens``, ``maxiter``,
+    ``maxfun`` and ``want_grad``, true, as in the other modes; the other arguments unused):
+    at each step the hypotheses and cost arguments (:func:`_loop_plan_data`), the
+    optimisation from the shifted warm start and from each restart start (the lowest cost
+    wins, ties keep the earlier: ``planner._restart``), then the control applied and the row
+    (:func:`_loop_step`); returns ``(planning cycles, all cycles, 0, 0, 0)`` (zeros without the
+    cycle counter).
 
     Why one function: numba links the layouts' compiled code into every kernel that calls them
     and optimises the linked module again; for the vectorised layout that second pass took
     12-14 s per calling kernel (measured: numba 0.68, LLVM host znver4), so two calling kernels
     paid it twice. ``want_grad`` is a run-time ``bool`` in both modes (a literal ``True`` would
     make numba compile both layouts a second time, for the literal's type)."""
-    if mode == _CLOSED_LOOP:
-        c_plan, c_all = _closed_loop(q, sens, maxiter, maxfun, loop)
-        return float(c_plan), float(c_all), 0, 0, 0
-    ws = _workspace(tx.shape[0], tx.shape[1], sens[5] != 0.0)
+    limited = sens[5] != 0.0
+    ws = _workspace(tx.shape[0], tx.shape[1], limited)
     if mode == _EVALUATE:
         for c in range(x.shape[0]):
             g_row = grad[c] if want_grad else grad[0]
             cost[c] = _value_grad(x[c], st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad, g_row)
         return 0.0, 0.0, 0, 0, 0
+    # _MINIMISE: one optimisation from x[0]; _CLOSED_LOOP: K steps of (restarts + 1) each.
+    # One call site of the (inlined) optimiser serves both: a second one would be typed and
+    # optimised again at compile time.
+    closed = mode == _CLOSED_LOOP
+    flags, scale, starts, noise = loop[0], loop[11], loop[12], loop[10]
+    timed = closed and flags[2] != 0
+    n = scale.shape[0] if closed else x.shape[1]
+    n_steps = noise.shape[0] if closed else 1
+    n_starts = starts.shape[0] + 1 if closed else 1
+    cfg_k = loop[5].copy() if closed else cfg
+    p0_k = np.empty(10) if closed else p0
+    warm = np.zeros(n)  # the closed loop's warm start, controls (H, 2) flattened
+    x_start = np.empty(n)
+    x_try = x_out if not closed else np.empty(n)
+    x_best = np.empty(n)
     data = (st, cfg, p0, q, sens, tx, ty, wts, ws, want_grad)
-    return boxqn.minimise(
-        _objective, data, x[0], maxiter, maxfun, boxqn.MEMORY, boxqn.PGTOL, boxqn.FTOL, x_out
-    )
+    plan_cycles = 0
+    t_begin = clock.cycles() if timed else 0
+    for k in range(1, n_steps + 1):
+        t0 = clock.cycles() if timed else 0
+        if closed:
+            tx_k, ty_k, wts_k = _loop_plan_data(k, loop, cfg_k, p0_k, n // 2)
+            ws_k = _workspace(n // 2, tx_k.shape[1], limited)
+            data = (loop[6], cfg_k, p0_k, q, sens, tx_k, ty_k, wts_k, ws_k, want_grad)
+        n_t = data[5].shape[1]
+        f_best, f_warm, status_best, winner = 0.0, 0.0, 0, 0
+        nit_total, calls, calls_best, work = 0, 0, 0, 0
+        for r in range(n_starts):
+            for i in range(n):
+                if not closed:
+                    x_start[i] = x[0, i]
+                elif r == 0:  # the warm start as BoxQN.minimise clips it
+                    x_start[i] = min(max(warm[i] / scale[i], -1.0), 1.0)
+                else:
+                    x_start[i] = starts[r - 1, i]
+            f, f0, nit, nfev, status = boxqn.minimise(
+                _objective, data, x_start, maxiter, maxfun, boxqn.MEMORY, boxqn.PGTOL,
+                boxqn.FTOL, x_try,
+            )  # fmt: skip
+            if not closed:
+                return f, f0, nit, nfev, status
+            # planner._restart: the lowest own cost wins, ties keep the earlier
+            calls += nfev
+            work += 2 * nfev * n_t * (n // 2)
+            nit_total += nit
+            if r == 0 or f < f_best:
+                f_best, status_best, winner, calls_best = f, status, r, calls
+                for i in range(n):
+                    x_best[i] = x_try[i]
+            if r == 0:
+                f_warm = f0
+        if timed:
+            plan_cycles += clock.cycles() - t0
+        plan = (f_best, f_warm, status_best, winner, nit_total, calls_best, work)
+        _loop_step(k, loop, x_best, warm, plan)
+    t_end = clock.cycles() if timed else 0
+    return float(plan_cycles), float(t_end - t_begin), 0, 0, 0
 
 
 @njit(cache=True, nogil=True)

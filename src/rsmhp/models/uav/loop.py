@@ -5,7 +5,7 @@ What runs where
 ---------------
 Python sets the run up once (scenario, the truth's process noise, the measurement normals, the
 detection uniforms: the same draws from the same keyed streams as the Python loop) and collects
-the step rows at the end. The 60 steps run in :func:`rsmhp.models.uav.fused._closed_loop`: the
+the step rows at the end. The 60 steps run in :func:`rsmhp.models.uav.fused._planner_kernel`: the
 step's hypotheses, the planner's cost arguments, the optimisation from the shifted warm start
 (and from each restart start), the first control applied, the target moved, the tracker's
 prediction and update (:func:`rsmhp.models.uav.stepper._advance`), the row. A family says how its
@@ -36,7 +36,7 @@ Python loop times from the step's stream to the end of the plan), converted to s
 the wall time of the whole compiled call; without a cycle counter (not x86-64) it is the
 run's wall time.
 
-The arrays of ``loop`` (:func:`rsmhp.models.uav.fused._closed_loop`)
+The arrays of ``loop`` (:func:`rsmhp.models.uav.fused._planner_kernel`)
 ----------------------------------------------------------------------
 ``flags`` (3,) int64: hypothesis kind (``fused.NOMINAL`` / ``fused.DRAWN``), generator handle,
 cycle counter on; ``F``, ``Q`` (4, 4); the stepper's aircraft and sensor tuples
@@ -142,7 +142,7 @@ def run(setup, method: Method, seed: int, run: int, scenario, w, zeta, det_u) ->
         t0 = time.perf_counter()
         c_plan, c_all, _, _, _ = fused._planner_kernel(
             fused._CLOSED_LOOP, fused._NO_POINT[None, :], *_UNUSED, q, sens, *_UNUSED_DATA,
-            False, setup.planner.maxiter, setup.planner.maxfun, fused._NO_COST,
+            True, setup.planner.maxiter, setup.planner.maxfun, fused._NO_COST,
             fused._NO_POINT[None, :], fused._NO_POINT, loop,
         )  # fmt: skip
         wall = time.perf_counter() - t0

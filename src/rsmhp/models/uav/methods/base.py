@@ -92,10 +92,13 @@ class Hypotheses:
                 )
 
     @classmethod
-    def equal(cls, states: np.ndarray, noise: np.ndarray | None = None) -> Hypotheses:
-        """``states`` with equal weights 1/T."""
+    def equal(
+        cls, states: np.ndarray, noise: np.ndarray | None = None, *, check: bool = True
+    ) -> Hypotheses:
+        """``states`` with equal weights 1/T (``check=False``: a generator whose output is
+        valid by construction, as the built-in families' are, skips the checks)."""
         n = np.shape(states)[0]
-        return cls(states, np.full(n, 1.0 / n), noise)
+        return cls(states, np.full(n, 1.0 / n), noise, check=check)
 
     @property
     def n(self) -> int:

@@ -71,4 +71,4 @@ class MonteCarlo(Method):
             rng,
             check=False,
         )
-        return Hypotheses.equal(states, noise)
+        return Hypotheses.equal(states, noise, check=False)

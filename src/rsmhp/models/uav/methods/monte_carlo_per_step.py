@@ -85,4 +85,4 @@ class MonteCarloPerStep(Method):
         states, noise = target.draw_independent(
             belief.x_hat, belief.P_hat, H, self.per_step * H, setup.target, rng, check=False
         )
-        return Hypotheses.equal(states, noise)
+        return Hypotheses.equal(states, noise, check=False)

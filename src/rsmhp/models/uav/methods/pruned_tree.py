@@ -110,4 +110,4 @@ class PrunedTree(Method):
             rng,
             check=False,
         )
-        return Hypotheses.equal(states)
+        return Hypotheses.equal(states, check=False)
