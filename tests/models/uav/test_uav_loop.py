@@ -160,6 +160,6 @@ def test_a_generator_error_propagates_and_no_generator_is_left_registered() -> N
     setup = _setup()
     with pytest.raises(RuntimeError, match="hypotheses failed at a late step"):
         simulate_run(setup, Broken(4), 1, 0, path="compiled")
-    assert fused.HYPOTHESES == {}
+    assert fused.CONTEXTS == {}
     simulate_run(setup, registry.from_name("rsmhp_nt16"), 1, 0)
-    assert fused.HYPOTHESES == {}
+    assert fused.CONTEXTS == {}

@@ -75,7 +75,7 @@ import numpy as np
 from numba import njit, objmode
 
 from rsmhp.core import boxqn, clock, guards, numba_cache
-from rsmhp.models.uav import kernel, stepper, target
+from rsmhp.models.uav import kernel, target
 from rsmhp.models.uav.kinematics import UAVParams
 from rsmhp.models.uav.sensor import SensorModel
 
@@ -720,29 +720,48 @@ _EVALUATE, _MINIMISE, _CLOSED_LOOP = 0, 1, 2
 #: how the compiled closed loop gets a step's hypotheses (``loop[0][0]``):
 #: :data:`NOMINAL`, NBO's noise-free prediction computed in compiled code
 #: (:func:`rsmhp.models.uav.target.nominal`'s kernel); :data:`DRAWN`, the method's own
-#: Python generator, called once per step from compiled code (:func:`_step_hypotheses`)
+#: Python generator, called once per step from compiled code (:func:`_drawn`)
 NOMINAL, DRAWN = 0, 1
 
-#: the hypothesis generators of the compiled closed loops now running, by handle (each run
-#: registers its generator for the length of its compiled call: :mod:`rsmhp.models.uav.loop`)
-HYPOTHESES: dict[int, object] = {}
+#: the Python side of the compiled closed loops now running, by handle: an object with
+#: ``draw(k) -> (states, weights)`` and ``advance(k, u0, u1) -> (detected, error, trace)``
+#: working on the same state arrays as the compiled loop
+#: (:class:`rsmhp.models.uav.loop._Context`, registered for the length of its compiled call)
+CONTEXTS: dict[int, object] = {}
 
 
-def _step_hypotheses(handle, k, uav_state, x_est, P_est):
-    """Called from the compiled closed loop (object mode) at step ``k``: the step's
-    hypotheses from the generator registered under ``handle``, as C-contiguous ``states``
-    (T, H, 4) and ``weights`` (T,)."""
-    states, weights = HYPOTHESES[int(handle)](int(k), uav_state, x_est, P_est)
+def _step_hypotheses(handle, k):
+    """The hypotheses of step ``k`` (object mode) as C-contiguous ``states`` (T, H, 4) and
+    ``weights`` (T,)."""
+    states, weights = CONTEXTS[int(handle)].draw(int(k))
     return np.ascontiguousarray(states, dtype=float), np.ascontiguousarray(weights, dtype=float)
 
 
+def _step_advance(handle, k, u0, u1):
+    """Step ``k`` after the plan with the control ``(u0, u1)`` (object mode): the state
+    arrays, shared with the compiled loop, updated in place."""
+    seen, err, tr = CONTEXTS[int(handle)].advance(int(k), u0, u1)
+    return bool(seen), float(err), float(tr)
+
+
 @njit(cache=True)
-def _drawn(handle, k, uav, x_est, P):  # pragma: no cover - compiled
-    """:func:`_step_hypotheses` called from compiled code (object mode: the GIL is taken, the
-    arrays are passed as numpy arrays, about 2 µs per call)."""
+def _drawn(handle, k):  # pragma: no cover - compiled
+    """:func:`_step_hypotheses` called from compiled code (object mode: the GIL is taken;
+    scalars in, the arrays out; a few µs per call)."""
     with objmode(states="float64[:, :, ::1]", weights="float64[::1]"):
-        states, weights = _step_hypotheses(handle, k, uav, x_est, P)
+        states, weights = _step_hypotheses(handle, k)
     return states, weights
+
+
+@njit(cache=True)
+def _advanced(handle, k, u0, u1):  # pragma: no cover - compiled
+    """:func:`_step_advance` called from compiled code. The closed-loop step
+    (:func:`rsmhp.models.uav.stepper._advance`) is called, not linked: linking would compile
+    it (about 7 s) into the planner kernel at set-up, on top of the kernel's own compile,
+    while a call costs a few µs per step."""
+    with objmode(seen="boolean", err="float64", tr="float64"):
+        seen, err, tr = _step_advance(handle, k, u0, u1)
+    return seen, err, tr
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -751,7 +770,7 @@ def _loop_plan_data(k, loop, cfg, p0, H):  # pragma: no cover - compiled
     (:data:`NOMINAL` or :data:`DRAWN`), their coordinates ``(tx, ty)`` (H, T), the weights and
     the divisor (``cfg[6]``) as :func:`weight_args` gives them, and the covariance's entries
     into ``p0``: the arguments :class:`Frozen` builds in the Python loop."""
-    flags, F, _Q, _u, _s, _c, uav, _xt, x_est, P, _n, _sc, _st, _v, _i = loop
+    flags, F, _c, _uav, _xt, x_est, P, _sc, _st, _v, _i = loop
     if flags[0] == NOMINAL:
         x0 = np.empty((1, 4))
         for a in range(4):
@@ -759,7 +778,7 @@ def _loop_plan_data(k, loop, cfg, p0, H):  # pragma: no cover - compiled
         states = target._propagate_kernel(x0, np.zeros((1, H, 4)), F, np.empty((1, H, 4)))
         weights = np.ones(1)
     else:
-        states, weights = _drawn(flags[1], k, uav, x_est, P)
+        states, weights = _drawn(flags[1], k)
     n_t = states.shape[0]
     tx = np.empty((H, n_t))
     ty = np.empty((H, n_t))
@@ -789,7 +808,7 @@ def _loop_step(k, loop, x_best, warm, plan):  # pragma: no cover - compiled
     winning plan ``x_best``, the next warm start (``shift_plan``), the first control applied by
     :func:`rsmhp.models.uav.stepper._advance` and the step's row (``plan``: cost, warm cost,
     status, winning start, iterations, kernel calls, work)."""
-    _f, F, Qm, ucfg, ssens, _c, uav, x_true, x_est, P, noise, scale, _st, vals, ints = loop
+    flags, _F, _c, uav, x_true, x_est, _P, scale, _st, vals, ints = loop
     n = scale.shape[0]
     controls = np.empty(n)
     for i in range(n):
@@ -798,10 +817,7 @@ def _loop_step(k, loop, x_best, warm, plan):  # pragma: no cover - compiled
         warm[i] = controls[i + 2]
     warm[n - 2] = controls[n - 2]
     warm[n - 1] = controls[n - 1]
-    seen, err, tr = stepper._advance(
-        uav, x_true, x_est, P, controls[0:2], noise[k - 1, 0:4], noise[k - 1, 4:6],
-        noise[k - 1, 6], F, Qm, ucfg, ssens,
-    )  # fmt: skip
+    seen, err, tr = _advanced(flags[1], k, controls[0], controls[1])
     f_best, f_warm, status, winner, nit, calls, work = plan
     row = vals[k - 1]
     row[0], row[1] = err, tr
@@ -857,12 +873,12 @@ def _planner_kernel(
     # One call site of the (inlined) optimiser serves both: a second one would be typed and
     # optimised again at compile time.
     closed = mode == _CLOSED_LOOP
-    flags, scale, starts, noise = loop[0], loop[11], loop[12], loop[10]
+    flags, scale, starts, vals = loop[0], loop[7], loop[8], loop[9]
     timed = closed and flags[2] != 0
     n = scale.shape[0] if closed else x.shape[1]
-    n_steps = noise.shape[0] if closed else 1
+    n_steps = vals.shape[0] if closed else 1
     n_starts = starts.shape[0] + 1 if closed else 1
-    cfg_k = loop[5].copy() if closed else cfg
+    cfg_k = loop[2].copy() if closed else cfg
     p0_k = np.empty(10) if closed else p0
     warm = np.zeros(n)  # the closed loop's warm start, controls (H, 2) flattened
     x_start = np.empty(n)
@@ -876,7 +892,7 @@ def _planner_kernel(
         if closed:
             tx_k, ty_k, wts_k = _loop_plan_data(k, loop, cfg_k, p0_k, n // 2)
             ws_k = _workspace(n // 2, tx_k.shape[1], limited)
-            data = (loop[6], cfg_k, p0_k, q, sens, tx_k, ty_k, wts_k, ws_k, want_grad)
+            data = (loop[3], cfg_k, p0_k, q, sens, tx_k, ty_k, wts_k, ws_k, want_grad)
         n_t = data[5].shape[1]
         f_best, f_warm, status_best, winner = 0.0, 0.0, 0, 0
         nit_total, calls, calls_best, work = 0, 0, 0, 0
@@ -1104,15 +1120,11 @@ _NO_COST = np.empty(1)
 _NO_LOOP = (
     np.zeros(3, dtype=np.int64),
     np.empty((4, 4)),
-    np.empty((4, 4)),
-    (0.0,) * 6,
-    (0.0,) * 9,
     np.empty(0),
     np.empty(4),
     np.empty(4),
     np.empty(4),
     np.empty((4, 4)),
-    np.empty((0, 7)),
     np.empty(0),
     np.empty((0, 0)),
     np.empty((0, 16)),
@@ -1232,5 +1244,5 @@ def warm_up() -> float:
 
 
 # the compiled planning step inlines rsmhp.core.boxqn: numba's cache does not see edits there,
-# and, for the closed loop, the step's kernel and the nominal hypothesis (stepper, target)
-numba_cache.invalidate_if_changed(_planner_kernel, [boxqn, clock, stepper, target])
+# and, for the closed loop, the nominal hypothesis (target) and the cycle counter (clock)
+numba_cache.invalidate_if_changed(_planner_kernel, [boxqn, clock, target])

@@ -5,11 +5,13 @@ What runs where
 ---------------
 Python sets the run up once (scenario, the truth's process noise, the measurement normals, the
 detection uniforms: the same draws from the same keyed streams as the Python loop) and collects
-the step rows at the end. The 60 steps run in :func:`rsmhp.models.uav.fused._planner_kernel`: the
-step's hypotheses, the planner's cost arguments, the optimisation from the shifted warm start
-(and from each restart start), the first control applied, the target moved, the tracker's
-prediction and update (:func:`rsmhp.models.uav.stepper._advance`), the row. A family says how its
-hypotheses are made by its class attribute ``closed_loop``
+the step rows at the end. The 60 steps run in one call of the planner kernel
+(:func:`rsmhp.models.uav.fused._planner_kernel`, its closed-loop mode): the step's hypotheses, the
+planner's cost arguments, the optimisation from the shifted warm start (and from each restart
+start), the first control, the target moved and the tracker's prediction and update (the Python
+loop's compiled step, :func:`rsmhp.models.uav.stepper._advance`, called through numba's object
+mode rather than linked, which would add its 7 s compile to the planner kernel's at set-up),
+the row. A family says how its hypotheses are made by its class attribute ``closed_loop``
 (:class:`rsmhp.models.uav.methods.Method`):
 
 * ``"nominal"`` (NBO): the noise-free prediction :math:`x_j = F^j \hat x`, computed in the compiled
@@ -36,15 +38,15 @@ Python loop times from the step's stream to the end of the plan), converted to s
 the wall time of the whole compiled call; without a cycle counter (not x86-64) it is the
 run's wall time.
 
-The arrays of ``loop`` (:func:`rsmhp.models.uav.fused._planner_kernel`)
-----------------------------------------------------------------------
-``flags`` (3,) int64: hypothesis kind (``fused.NOMINAL`` / ``fused.DRAWN``), generator handle,
-cycle counter on; ``F``, ``Q`` (4, 4); the stepper's aircraft and sensor tuples
-(:class:`rsmhp.models.uav.stepper.Stepper`); the planner's ``cfg`` (8,) (its weight divisor set
-per step); the UAV state, true target and estimate (4,) and covariance (4, 4), updated in
-place; ``noise`` (K, 7): the truth's process noise (4), measurement normals (2), detection
-uniform; ``scale`` (2H,) the control scale; ``starts`` (R, 2H) the restarts' normalised
-starts as the Python loop clips them; outputs ``vals`` (K, 16): the 14 step values of
+The arrays of ``loop`` (the planner kernel's closed-loop mode)
+----------------------------------------------------------------
+``flags`` (3,) int64: hypothesis kind (``fused.NOMINAL`` / ``fused.DRAWN``), the handle of
+the run's Python side in ``fused.CONTEXTS`` (its draws and the step after the plan, on the
+same state arrays), cycle counter on; ``F`` (4, 4); the planner's ``cfg`` (8,) (its weight
+divisor set per step); the UAV state, true target and estimate (4,) and covariance (4, 4),
+updated in place; ``scale``
+(2H,) the control scale; ``starts`` (R, 2H) the restarts' normalised starts as the Python
+loop clips them; outputs ``vals`` (K, 16): the 14 step values of
 :data:`rsmhp.models.uav.simulation.STEP_VALUES`, the optimiser status and the winning start;
 ``ints`` (K, 4): iterations, kernel calls, work, detected.
 """
@@ -53,7 +55,6 @@ from __future__ import annotations
 
 import itertools
 import time
-from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,7 +63,7 @@ from rsmhp.core import clock
 from rsmhp.core.seeding import job_rngs
 from rsmhp.models.uav import fused
 from rsmhp.models.uav.methods import Method
-from rsmhp.models.uav.planner import BoxQN, SampledCostPlanner, restart_starts
+from rsmhp.models.uav.planner import Belief, BoxQN, SampledCostPlanner, restart_starts
 from rsmhp.models.uav.stepper import Stepper
 
 __all__ = ["KINDS", "CompiledRun", "path", "run"]
@@ -110,20 +111,12 @@ def run(setup, method: Method, seed: int, run: int, scenario, w, zeta, det_u) ->
     (``scenario``, process noise ``w`` (K, 4), normals ``zeta`` (K, 2), uniforms ``det_u``
     (K,)); the caller checked the arguments and :func:`path`."""
     K, H = setup.steps, setup.planner.horizon
-    planner = method.planner(setup)
     kind = type(method).closed_loop
-    step = Stepper(setup.uav, setup.target, setup.sensor)
     scale = np.tile(setup.uav.control_scale, H).astype(float)
     R = setup.planner.restarts
     starts = np.empty((R, 2 * H))
     for i, x0 in enumerate(restart_starts(H, R)):  # as BoxQN.minimise clips problem.controls(x0)
         starts[i] = np.clip((x0 * scale).reshape(H, 2).ravel() / scale, -1.0, 1.0)
-    uav = np.array(scenario.uav, dtype=float)
-    x_true = np.array(scenario.target, dtype=float)
-    x_est = np.array(scenario.estimate, dtype=float)
-    P = np.array(setup.P0, dtype=float)
-    noise = np.empty((K, 7))
-    noise[:, 0:4], noise[:, 4:6], noise[:, 6] = w, zeta, det_u
     cfg = np.array((*fused._uav_args(setup.uav), 0.0, setup.target.dt), dtype=float)
     q = fused._constant_entries(np.asarray(setup.target.Q, dtype=float).tobytes())
     sens = fused._sensor_args(setup.sensor)
@@ -132,12 +125,14 @@ def run(setup, method: Method, seed: int, run: int, scenario, w, zeta, det_u) ->
     flags = np.array([fused.NOMINAL if kind == "nominal" else fused.DRAWN, handle, timed])
     vals = np.zeros((K, 16))
     ints = np.zeros((K, 4), dtype=np.int64)
-    loop = (
-        flags, step.F, step.Q, step.ucfg, step.sens, cfg, uav, x_true, x_est, P, noise, scale,
-        starts, vals, ints,
+    # the state arrays: updated in place by the compiled loop and by the context's steps
+    state = (
+        np.array(scenario.uav, dtype=float), np.array(scenario.target, dtype=float),
+        np.array(scenario.estimate, dtype=float), np.array(setup.P0, dtype=float),
     )  # fmt: skip
-    if kind == "drawn":
-        fused.HYPOTHESES[handle] = _generator(planner, method, setup, seed, run)
+    F = np.ascontiguousarray(setup.target.F, dtype=float)
+    loop = (flags, F, cfg, *state, scale, starts, vals, ints)
+    fused.CONTEXTS[handle] = _Context(setup, method, seed, run, state, w, zeta, det_u)
     try:
         t0 = time.perf_counter()
         c_plan, c_all, _, _, _ = fused._planner_kernel(
@@ -147,35 +142,49 @@ def run(setup, method: Method, seed: int, run: int, scenario, w, zeta, det_u) ->
         )  # fmt: skip
         wall = time.perf_counter() - t0
     finally:
-        fused.HYPOTHESES.pop(handle, None)
+        fused.CONTEXTS.pop(handle, None)
     plan_seconds = wall * c_plan / c_all if timed and c_all > 0 else wall
     return CompiledRun(vals, ints, plan_seconds)
+
+
+class _Context:
+    """The Python side of one compiled run: the step's hypotheses as the Python loop draws
+    them (the step's own stream: :func:`rsmhp.core.seeding.job_rngs` gives
+    ``job_rng(..., step=k)``'s streams in step order; the planner's ``draw`` at a belief of
+    copies), and the step after the plan by the Python loop's compiled
+    :class:`rsmhp.models.uav.stepper.Stepper` with the run's noise."""
+
+    def __init__(self, setup, method: Method, seed: int, run: int, state, w, zeta, det_u) -> None:
+        self.planner = method.planner(setup)
+        self.rngs = (
+            job_rngs(seed, "uav_plan", "step", range(1, setup.steps + 1), run=run,
+                     **method.job_key())
+            if method.uses_rng
+            else None
+        )  # fmt: skip
+        self.next_draw = 1
+        self.stepper = Stepper(setup.uav, setup.target, setup.sensor)
+        self.w, self.zeta, self.det_u = w, zeta, det_u
+        self.uav, self.x_true, self.x_est, self.P = state
+        self.control = np.empty(2)
+
+    def draw(self, k: int):
+        if k != self.next_draw:  # the streams are consumed in step order
+            raise RuntimeError(f"compiled loop asked for step {k}, expected {self.next_draw}")
+        self.next_draw += 1
+        rng = next(self.rngs) if self.rngs is not None else None
+        belief = Belief(self.uav.copy(), self.x_est.copy(), self.P.copy())
+        hyp = self.planner.draw(belief, rng)
+        return hyp.states, hyp.weights
+
+    def advance(self, k: int, u0: float, u1: float):
+        self.control[0], self.control[1] = u0, u1
+        return self.stepper.advance(
+            self.uav, self.x_true, self.x_est, self.P, self.control, self.w[k - 1],
+            self.zeta[k - 1], self.det_u[k - 1],
+        )  # fmt: skip
 
 
 # the arguments of the planner kernel the closed loop does not read (st, cfg, p0; tx, ty, wts)
 _UNUSED = (np.empty(0), np.empty(0), np.empty(0))
 _UNUSED_DATA = (np.empty((0, 0)), np.empty((0, 0)), np.empty(0))
-
-
-def _generator(planner: SampledCostPlanner, method: Method, setup, seed: int, run: int) -> Callable:
-    """The step's hypotheses as the Python loop draws them: the step's own stream (in step
-    order, :func:`rsmhp.core.seeding.job_rngs` gives ``job_rng(..., step=k)``'s streams) and
-    the planner's ``draw`` at a belief of copies."""
-    from rsmhp.models.uav.planner import Belief
-
-    rngs = (
-        job_rngs(seed, "uav_plan", "step", range(1, setup.steps + 1), run=run, **method.job_key())
-        if method.uses_rng
-        else None
-    )
-    expected = [1]
-
-    def draw(k: int, uav: np.ndarray, x_est: np.ndarray, P: np.ndarray):
-        if k != expected[0]:  # the streams are consumed in step order
-            raise RuntimeError(f"compiled loop asked for step {k}, expected {expected[0]}")
-        expected[0] += 1
-        rng = next(rngs) if rngs is not None else None
-        hyp = planner.draw(Belief(uav.copy(), x_est.copy(), P.copy()), rng)
-        return hyp.states, hyp.weights
-
-    return draw
