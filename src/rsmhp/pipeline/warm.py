@@ -9,15 +9,17 @@ and ``make test`` run first), spread over the machine's cores.
 
 What is compiled, by whom (:data:`TASKS`; each task in its own process, largest first):
 
-* the planner kernel (:mod:`rsmhp.models.uav.fused`: cost, gradient and the whole planning
-  step in one compiled function, plus the covariance traces and the path) and the scrambled
-  Sobol' points (:mod:`rsmhp.core.designs`);
+* the planner kernel (:mod:`rsmhp.models.uav.fused`: cost, gradient, the whole planning step
+  and the compiled closed loop in one compiled function, with the nominal hypothesis it links
+  and the closed loop's small kernels);
 * the tree search with the closed-loop step it links (:mod:`rsmhp.models.uav.dpw`,
-  :mod:`rsmhp.models.uav.stepper`), the hypotheses (:mod:`rsmhp.models.uav.target`) and the
-  LQG pruned tree (:mod:`rsmhp.models.lqg.regret`).
+  :mod:`rsmhp.models.uav.stepper`), the hypotheses (:mod:`rsmhp.models.uav.target`), the
+  LQG pruned tree (:mod:`rsmhp.models.lqg.regret`), the planner module's covariance traces
+  and path (``fused.warm_up_extras``) and the scrambled Sobol' points
+  (:mod:`rsmhp.core.designs`).
 
-The two take about the same time (about 22 s and 25 s of CPU on the AVX-512 machine of
-docs/performance.md), so two cores compile everything in the time of the longer.
+The planner kernel is the longest single compile (docs/performance.md, "Cold start"), so the
+second process takes everything else.
 
 Modules whose compiled code links another module's (the tree search links the closed-loop
 step) share a task, so no kernel is compiled twice at once. A kernel that is already in the
@@ -40,14 +42,20 @@ from concurrent.futures import ProcessPoolExecutor
 __all__ = ["LINKED", "TASKS", "main", "warm"]
 
 #: tasks of one process each: the modules whose ``warm_up()`` it calls, in order
+#: (``module:function`` calls that function of the module instead)
 TASKS: tuple[tuple[str, ...], ...] = (
-    ("rsmhp.models.uav.fused", "rsmhp.core.designs"),
+    # the planner kernel alone: the longest compile (cost, gradient, planning step and the
+    # closed loop in one function)
+    ("rsmhp.models.uav.fused",),
     (
         "rsmhp.models.uav.dpw",
         "rsmhp.models.uav.stepper",
         "rsmhp.models.uav.target",
         # after target: both compile numba's np.partition, once per process
         "rsmhp.models.lqg.regret",
+        # the planner module's small kernels (traces, path), beside the kernel's compile
+        "rsmhp.models.uav.fused:warm_up_extras",
+        "rsmhp.core.designs",
     ),
 )
 
@@ -57,8 +65,13 @@ LINKED: dict[str, str] = {"rsmhp.core.boxqn": "rsmhp.models.uav.fused"}
 
 
 def _run(modules: tuple[str, ...]) -> list[tuple[str, float]]:
-    """Call each module's ``warm_up()`` (in this process); (module, seconds) per module."""
-    return [(name, float(importlib.import_module(name).warm_up())) for name in modules]
+    """Call each module's ``warm_up()`` (or the function a ``module:function`` entry names) in
+    this process; (entry, seconds) per entry."""
+    out = []
+    for name in modules:
+        module, _, func = name.partition(":")
+        out.append((name, float(getattr(importlib.import_module(module), func or "warm_up")())))
+    return out
 
 
 def warm(cores: int) -> tuple[float, list[tuple[str, float]]]:
