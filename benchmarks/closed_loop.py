@@ -187,8 +187,8 @@ def main(argv: list[str] | None = None) -> None:
                     loops = out["path"]
             print(f"  {p}: round {r + 1}/{a.rounds} done", file=sys.stderr)
         print(f"\n{p}:")
-        print("| member | loop | baseline (ms) | this (ms) | ratio |")
-        print("|---|---|---|---|---|")
+        print("| member | loop | baseline (ms) | this (ms) | ratio | rows as baseline's |")
+        print("|---|---|---|---|---|---|")
         results[p] = {}
         for m in members:
             b = statistics.median(times["baseline"][m]) * 1e3
