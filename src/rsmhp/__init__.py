@@ -18,7 +18,8 @@ Sub-packages
                     NBO), boxqn (compiled projected L-BFGS over [-1, 1]^n), stats (intervals,
                     paired differences, slopes, Holm, t-test power, probability of
                     improvement), guards (argument checks), numba_cache (drops a compiled
-                    module's cache when a module it inlines changed)
+                    module's cache when a module it inlines changed), clock (a cycle counter
+                    compiled code can read)
   models            the case studies' models. models.lqg: oven (the scalar oven LQG and its
                     closed forms), linear_quadratic (linear-Gaussian problems with quadratic
                     cost and their exact oracles), horizon (long-horizon limits), ablation
@@ -28,7 +29,8 @@ Sub-packages
                     stepper (compiled closed-loop step), kernel (numpy oracle), fused (compiled
                     weighted cost + exact gradient), planner (Planner and Optimiser
                     protocols), methods (registry, one module per planning family), dpw
-                    (compiled tree search), simulation, runs (closed-loop runs through the
+                    (compiled tree search), simulation, loop (the compiled closed loop and
+                    which families take it), runs (closed-loop runs through the
                     run store: their key, shared by the studies), scoring (open-loop scoring
                     of belief states, shared by the studies), recording
   pipeline          workflow support: config (config files and schema checks, ``python -m
@@ -38,7 +40,8 @@ Sub-packages
                     content-addressed store of computed runs, shared by the rules), parallel
                     (joblib within a thread budget), resources (memory estimates), cluster (SLURM
                     pre-flight), protocol (seed streams, planner configurations, tuning rule,
-                    preregistration), script (logging and code checks of rule scripts), warm
+                    preregistration), split (jobs split into chunks and merged again), script
+                    (logging and code checks of rule scripts), warm
                     (compiles every numba kernel once per machine, ``python -m
                     rsmhp.pipeline.warm``)
   report            ledger (KeyNumber, Claim, Section), verdicts (verdict rules as objects),
