@@ -35,8 +35,10 @@ __all__ = [
     "horizon_jobs",
     "merge_checked",
     "merge_ordered",
+    "merge_run_chunks",
     "n_chunks",
     "restrict",
+    "run_chunk",
 ]
 
 T = TypeVar("T")
@@ -148,3 +150,32 @@ def merge_checked(
         raise ValueError(f"merge_checked: {len(paths)} files but {len(contracts)} contracts")
     frames = [read_checked(p, c) for p, c in zip(paths, contracts, strict=True)]
     return check_table(merge_ordered(frames, keys, orders), what, whole)
+
+
+def run_chunk(n_runs: int, jobs: int, k: int) -> list[int]:
+    """The run indices of chunk ``k`` of runs ``0..n_runs-1`` split in ``jobs`` jobs."""
+    return chunk(range(int(n_runs)), jobs, k)
+
+
+def merge_run_chunks(
+    paths: Sequence[str],
+    whole: Contract,
+    n_runs: int,
+    jobs: int,
+    keys: Sequence[str],
+    orders: Mapping[str, Sequence[Any]] | None = None,
+    what: str = "the chunks together",
+    caller: str = "merge_run_chunks",
+) -> pd.DataFrame:
+    """A table split into chunks of runs (:func:`run_chunk`) from its chunk files ``paths``
+    (chunk 0, 1, ...): their number checked against :func:`n_chunks` (the message names
+    ``caller``), each checked against the rows its runs must hold (``whole`` restricted to
+    them), then :func:`merge_checked`."""
+    expected = n_chunks(n_runs, jobs)
+    if len(paths) != expected:
+        raise ValueError(
+            f"{caller}: {len(paths)} chunk files for {n_runs} runs in {jobs} jobs "
+            f"(expected {expected})"
+        )
+    parts = [restrict(whole, {"run": run_chunk(n_runs, jobs, k)}) for k in range(len(paths))]
+    return merge_checked([str(p) for p in paths], parts, whole, keys, orders, what)

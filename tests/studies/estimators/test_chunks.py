@@ -21,22 +21,8 @@ from rsmhp.studies.estimators.chunks import (
     merge_ablation,
     run_ablation_chunk,
 )
+from tests.studies.estimators.test_estimator_study import MODEL, NCV
 
-MODEL = {"a": 0.5, "x0": 0.0, "r": 10.0, "target": 1.0, "sigma": 1.0}
-NCV = {
-    "name": "ncv2",
-    "kind": "ncv_2d",
-    "dt": 1.0,
-    "q": 1.0,
-    "w_pos": 0.1,
-    "w_vel": 0.1,
-    "r_u": 1.0,
-    "f_pos": 5.0,
-    "f_vel": 1.0,
-    "target": [10.0, 5.0, 0.0, 0.0],
-    "x0": [0.0, 0.0, 1.0, 0.5],
-    "u": [[0.5, 0.2], [0.3, 0.1]],
-}
 # the ncv problem first: the merged order is the config's, not the alphabet's
 CFG = {
     "replicates": 12,

@@ -16,7 +16,7 @@ from collections.abc import Sequence
 import pandas as pd
 
 from rsmhp.pipeline.protocol import Configuration
-from rsmhp.pipeline.split import chunk, merge_checked, n_chunks, restrict
+from rsmhp.pipeline.split import merge_run_chunks, n_chunks, run_chunk
 from rsmhp.studies.frontier.simulate import config_runs_contract
 
 __all__ = ["RULE", "confirm_chunks", "confirm_runs", "merge_confirm"]
@@ -32,7 +32,7 @@ def confirm_chunks(n_runs: int, jobs: int) -> list[int]:
 
 def confirm_runs(n_runs: int, jobs: int, k: int) -> list[int]:
     """The run indices of chunk ``k`` of runs ``0..n_runs-1`` split in ``jobs`` jobs."""
-    return chunk(range(int(n_runs)), jobs, k)
+    return run_chunk(n_runs, jobs, k)
 
 
 def merge_confirm(
@@ -45,19 +45,14 @@ def merge_confirm(
     """The confirmatory table of ``model`` from its chunk files ``paths`` (chunk 0, 1, ...):
     each checked against the rows its runs must hold, merged in the unsplit order
     (configuration as in ``configs``, then run) and checked as a whole."""
-    runs = range(int(n_runs))
-    whole = config_runs_contract(RULE, configs, runs, model)
-    if len(paths) != n_chunks(n_runs, jobs):
-        raise ValueError(
-            f"merge_confirm: {len(paths)} chunk files for {n_runs} runs in {jobs} jobs "
-            f"(expected {n_chunks(n_runs, jobs)})"
-        )
-    parts = [restrict(whole, {"run": confirm_runs(n_runs, jobs, k)}) for k in range(len(paths))]
-    return merge_checked(
-        [str(p) for p in paths],
-        parts,
+    whole = config_runs_contract(RULE, configs, range(int(n_runs)), model)
+    return merge_run_chunks(
+        paths,
         whole,
+        n_runs,
+        jobs,
         keys=("config", "run"),
         orders={"config": [c.name for c in configs]},
         what=f"results/frontier/confirm/{model}.csv (the chunks together)",
+        caller="merge_confirm",
     )

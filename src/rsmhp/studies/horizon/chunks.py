@@ -21,7 +21,7 @@ from typing import Any
 
 import pandas as pd
 
-from rsmhp.pipeline.split import chunk, horizon_jobs, merge_checked, n_chunks, restrict
+from rsmhp.pipeline.split import horizon_jobs, merge_run_chunks, n_chunks, run_chunk
 from rsmhp.studies.horizon.simulate_optimiser import split_contract
 from rsmhp.studies.horizon.simulate_uav import _names, closed_contract, horizon_contracts
 
@@ -47,7 +47,7 @@ def unit_jobs(jobs: int, H: int, horizons: Iterable[int], n_runs: int) -> int:
 def unit_runs(n_runs: int, jobs: int, k: int) -> list[int]:
     """The runs of chunk ``k`` when runs ``0..n_runs-1`` make ``jobs`` chunks (``jobs`` as
     :func:`unit_jobs` gives it)."""
-    return chunk(range(int(n_runs)), jobs, k)
+    return run_chunk(n_runs, jobs, k)
 
 
 def units(
@@ -90,15 +90,6 @@ def per_unit(paths: Sequence[str], layout: Sequence[tuple[str, int, int]]) -> li
     return out
 
 
-def _chunk_count(paths: Sequence[Any], n_runs: int, jobs: int, what: str) -> int:
-    if len(paths) != n_chunks(n_runs, jobs):
-        raise ValueError(
-            f"{what}: {len(paths)} chunk files for {n_runs} runs in {jobs} jobs "
-            f"(expected {n_chunks(n_runs, jobs)})"
-        )
-    return len(paths)
-
-
 def merge_horizon(
     approx_paths: Sequence[str],
     regret_paths: Sequence[str],
@@ -111,24 +102,17 @@ def merge_horizon(
     chunks' files (chunk 0, 1, ...); ``cfg`` is ``horizon.uav``, ``jobs`` the unit's job
     count (:func:`unit_jobs`)."""
     n_runs = int(cfg["runs"])
-    n = _chunk_count(approx_paths, n_runs, jobs, "merge_horizon")
-    _chunk_count(regret_paths, n_runs, jobs, "merge_horizon")
     c_approx, c_regret = horizon_contracts(cfg, model, H)
-    runs = [{"run": unit_runs(n_runs, jobs, k)} for k in range(n)]
-    approx = merge_checked(
-        [str(p) for p in approx_paths],
-        [restrict(c_approx, r) for r in runs],
-        c_approx,
-        keys=("run",),
+    approx = merge_run_chunks(
+        approx_paths, c_approx, n_runs, jobs, keys=("run",),
         what=f"results/horizon/uav/{model}_H{H}_approx.csv (the chunks together)",
-    )
-    regret = merge_checked(
-        [str(p) for p in regret_paths],
-        [restrict(c_regret, r) for r in runs],
-        c_regret,
-        keys=("run",),
+        caller="merge_horizon",
+    )  # fmt: skip
+    regret = merge_run_chunks(
+        regret_paths, c_regret, n_runs, jobs, keys=("run",),
         what=f"results/horizon/uav/{model}_H{H}_regret.csv (the chunks together)",
-    )
+        caller="merge_horizon",
+    )  # fmt: skip
     return approx, regret
 
 
@@ -137,17 +121,13 @@ def merge_closed(
 ) -> pd.DataFrame:
     """Rule ``horizon_uav_closed_merge``: the closed-loop table of (``model``, ``H``) from the
     chunks' files; ``cfg`` is ``horizon.uav`` (its ``closed_runs`` are split)."""
-    n_runs = int(cfg["closed_runs"])
-    n = _chunk_count(paths, n_runs, jobs, "merge_closed")
-    whole = closed_contract(cfg, model, H)
-    return merge_checked(
-        [str(p) for p in paths],
-        [restrict(whole, {"run": unit_runs(n_runs, jobs, k)}) for k in range(n)],
-        whole,
+    return merge_run_chunks(
+        paths, closed_contract(cfg, model, H), int(cfg["closed_runs"]), jobs,
         keys=("method", "run"),
         orders={"method": [m.name for m in _names(cfg).values()]},
         what=f"results/horizon/uav/{model}_H{H}_closed.csv (the chunks together)",
-    )
+        caller="merge_closed",
+    )  # fmt: skip
 
 
 def merge_optimiser(
@@ -155,13 +135,8 @@ def merge_optimiser(
 ) -> pd.DataFrame:
     """Rule ``horizon_optimiser_merge``: the optimiser split of (``model``, ``H``) from the
     chunks' files; ``cfg`` is ``horizon.optimiser``."""
-    n_runs = int(cfg["runs"])
-    n = _chunk_count(paths, n_runs, jobs, "merge_optimiser")
-    whole = split_contract(cfg, model, H)
-    return merge_checked(
-        [str(p) for p in paths],
-        [restrict(whole, {"run": unit_runs(n_runs, jobs, k)}) for k in range(n)],
-        whole,
-        keys=("run",),
+    return merge_run_chunks(
+        paths, split_contract(cfg, model, H), int(cfg["runs"]), jobs, keys=("run",),
         what=f"results/horizon/optimiser/{model}_H{H}.csv (the chunks together)",
-    )
+        caller="merge_optimiser",
+    )  # fmt: skip
