@@ -14,6 +14,10 @@ folded in ("not shown on the paper's setups; shown on the variants").
 * A hedged statement ("may", :data:`HEDGED_RULE`) is an existence claim, so one piece that
   shows it suffices, unless another piece on the same kind of setup shows it absent (``not
   supported`` or ``equivalent``): then the evidence disagrees and the verdict is ``mixed``.
+
+The words (what each statement says, its note, the rules' conditions, how a verdict reads) are
+macros of the template ``statements.md`` beside this module (:data:`WORDS`); the statements'
+ids, places in the paper and evidence are data here.
 """
 
 from __future__ import annotations
@@ -22,6 +26,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 
 from rsmhp.report.ledger import VERDICTS, Claim
+from rsmhp.report.templates import Words
 from rsmhp.report.verdicts import Case, Facts, Rule
 
 __all__ = [
@@ -29,6 +34,7 @@ __all__ = [
     "HEDGED_RULE",
     "NOT_TESTED",
     "STATEMENTS",
+    "WORDS",
     "Judgement",
     "Statement",
     "evidence_facts",
@@ -38,6 +44,9 @@ __all__ = [
 
 #: the verdict of a kind of setup without evidence
 NOT_TESTED = "not tested"
+
+#: the words of the statements and their rules (``src/rsmhp/report/statements.md``)
+WORDS = Words("rsmhp.report", "statements.md")
 
 
 @dataclass(frozen=True)
@@ -74,11 +83,11 @@ class Statement:
 _ABSENT = ("not supported", "equivalent")
 
 GENERAL_RULE = Rule(
-    basis="over its pieces of evidence on one kind of setup (the paper's, or the variants)",
+    basis=WORDS("general_basis"),
     cases=(
-        Case(NOT_TESTED, "there is none", lambda f: f["n"] == 0),
+        Case(NOT_TESTED, WORDS("no_evidence"), lambda f: f["n"] == 0),
         *(
-            Case(v, f"every piece is {v}", lambda f, v=v: f[v] == f["n"])
+            Case(v, WORDS("every_piece", verdict=v), lambda f, v=v: f[v] == f["n"])
             for v in ("supported", "not supported", "equivalent", "inconclusive")
         ),
     ),
@@ -86,24 +95,18 @@ GENERAL_RULE = Rule(
 )
 
 HEDGED_RULE = Rule(
-    basis="the paper says 'may', so one setting where it happens suffices unless another shows "
-    "it absent; over its pieces of evidence on one kind of setup",
+    basis=WORDS("hedged_basis"),
     cases=(
-        Case(NOT_TESTED, "there is none", lambda f: f["n"] == 0),
+        Case(NOT_TESTED, WORDS("no_evidence"), lambda f: f["n"] == 0),
         Case(
             "supported",
-            "some piece is supported and none is not supported or equivalent",
+            WORDS("hedged_supported"),
             lambda f: f["supported"] >= 1 and f["not supported"] + f["equivalent"] == 0,
         ),
-        Case(
-            "mixed",
-            "some piece is supported and some is not supported or equivalent (shown and shown "
-            "absent)",
-            lambda f: f["supported"] >= 1,
-        ),
+        Case("mixed", WORDS("hedged_mixed"), lambda f: f["supported"] >= 1),
         Case(
             "not supported",
-            "every piece is not supported or equivalent (shown absent wherever tested)",
+            WORDS("hedged_not_supported"),
             lambda f: f["not supported"] + f["equivalent"] == f["n"],
         ),
     ),
@@ -147,21 +150,10 @@ class Judgement:
         return "; ".join(f"{v}: {', '.join(ids)}" for v, ids in by.items() if ids)
 
 
-_SHOWN = {
-    "supported": "shown",
-    "not supported": "contradicted",
-    "equivalent": "absent (equivalent)",
-    "inconclusive": "not shown (inconclusive)",
-    "mixed": "mixed",
-    NOT_TESTED: "not tested",
-}
-
-
 def _scope(on_paper: str, paper: Sequence[Claim], on_var: str | None, var: Sequence[Claim]) -> str:
-    out = f"{_SHOWN[on_paper]} on the paper's setups" + (f" ({_pieces(paper)})" if paper else "")
-    if on_var is not None:
-        out += f"; {_SHOWN[on_var]} on the variants ({_pieces(var)})"
-    return out
+    return WORDS(
+        "scope", on_paper=on_paper, paper=_pieces(paper), on_variants=on_var, variants=_pieces(var)
+    )
 
 
 def judge(statement: Statement, claims: Iterable[Claim]) -> Judgement | None:
@@ -219,101 +211,35 @@ def judge_all(
     return out, untested
 
 
-_PROP1_GAP = (
-    "The paper's proof of Prop. 1 orders the leaves left to right and states that "
-    "Cov(g_i, g_j) = 0 when |i − j| > N, because leaves under different parents share no "
-    "draw. That holds for a tree whose every node draws its own noise, not for the tree the "
-    "paper builds (Fig. 1a: one set of N draws per level, shared by every node). There, two "
-    "leaves share the draw of level k whenever their level-k indices agree, however far apart "
-    "they are: leaf (1, 1, …, 1) and leaf (2, 1, …, 1) lie N^{H−1} positions apart and share "
-    "H − 1 of their H draws. With g = c + bᵀw + wᵀKw (the LQG's cost as a quadratic form of "
-    "the stacked noise w ~ N(0, S), S = I_H ⊗ Σ, c = J_NBO), two leaves sharing the draws of "
-    "the set L of levels have Cov = Var(E[g | w_L]) > 0, and averaging over all pairs gives "
-    "Var(J_tree) = bᵀSb/N + 2 tr((KS)²)/N² + 2(N−1)/N² Σ_k tr((K_kk Σ)²) (estimator study, "
-    "appendix), which decays like 1/N, not like 1/N^H. The conclusion "
-    "(convergence in probability) still holds because this variance tends to 0, but the "
-    "covariances do not vanish with |i − j|, so the cited condition is not met; the "
-    "estimator study (EST-1) measures the 1/N rate."
-)
-
-#: the statements of the paper tested here, in the paper's order
+#: the statements of the paper tested here, in the paper's order (what each says and its note:
+#: ``s<n>_says`` and ``s<n>_note`` of :data:`WORDS`)
 STATEMENTS: tuple[Statement, ...] = (
     Statement(
         "S1",
         "Sec. II",
-        "NBO completely ignores the uncertainty of the state evolution and may generate "
-        "severely sub-optimal controls",
+        WORDS("s1_says"),
         ("DEC-1", "DEC-6"),
         hedged=True,
         variants=("DEC-7-*", "DEC-8a", "DEC-8b"),
-        note="In the oven LQG with open-loop controls, J(u) − J_NBO(u) = r v_H does not "
-        "depend on u, so NBO's minimiser is the exact optimum before any simulation runs "
-        "(certainty equivalence): DEC-1 confirms the derivation numerically, it cannot come "
-        "out otherwise on this model.",
+        note=WORDS("s1_note"),
     ),
+    Statement("S2", "Sec. II, Prop. 1", WORDS("s2_says"), ("EST-1",), note=WORDS("s2_note")),
+    Statement("S3", "Sec. II, Prop. 2; Sec. II-A", WORDS("s3_says"), ("LQG-4", "EST-2")),
     Statement(
-        "S2",
-        "Sec. II, Prop. 1",
-        "the uniform average over the tree's trajectories converges in probability to J as "
-        "the number of draws N grows",
-        ("EST-1",),
-        note=_PROP1_GAP,
-    ),
-    Statement(
-        "S3",
-        "Sec. II, Prop. 2; Sec. II-A",
-        "the likeliness-weighted average (over the tree, or over independent trajectories) "
-        "converges in probability to J",
-        ("LQG-4", "EST-2"),
-    ),
-    Statement(
-        "S4",
-        "Sec. II-A, Prop. 3",
-        "for linear dynamics and a linear cost, P(|J_n − J| ≥ ε) ≤ Var(p)/(n ε²) for the "
-        "average J_n of n independent trajectories, with Var(p) = C[Σ_k 𝒜_k Σ 𝒜_kᵀ]Cᵀ "
-        "(𝒜_k = Σ_{q<H−k} A^q, C the cost's row vector)",
-        ("LIN-1",),
-        variants=("LQG-3", "EST-3"),
+        "S4", "Sec. II-A, Prop. 3", WORDS("s4_says"), ("LIN-1",), variants=("LQG-3", "EST-3")
     ),
     Statement(
         "S5",
         "Sec. II; Sec. III-B after Fig. 4",
-        "the N_T trend 'suggests that pruning methods would degrade the performance' of "
-        "RS-MHP (keeping the M most likely trajectories) 'but can provide gains' in computation",
+        WORDS("s5_says"),
         ("EST-4", "DEC-4", "UAV-3"),
         hedged=True,
-        note="In the oven LQG with open-loop controls NBO's choice is the exact optimum (S1), "
-        "and pruning keeps the most likely, near-zero noises, so a pruned tree drifts toward "
-        "NBO's choice: there pruning cannot degrade decisions (DEC-4). The computation half "
-        "has no evidence of its own: the UAV timings are printed as contrary evidence of "
-        "UAV-3 where the pruned tree was the slower.",
+        note=WORDS("s5_note"),
     ),
+    Statement("S6", "Sec. III-A", WORDS("s6_says"), ("LQG-1",)),
+    Statement("S7", "Sec. III-A, Fig. 3", WORDS("s7_says"), ("LQG-2",)),
+    Statement("S8", "Sec. III-B, Fig. 4", WORDS("s8_says"), ("UAV-1",)),
     Statement(
-        "S6",
-        "Sec. III-A",
-        "in the oven LQG, NBO's cost error is |J_NBO − J| = r σ² Σ_{n=0}^{H−1} (1−a)^{2n} "
-        "(derived for H = 2, stated for any H)",
-        ("LQG-1",),
-    ),
-    Statement(
-        "S7",
-        "Sec. III-A, Fig. 3",
-        "in the oven LQG the Monte-Carlo estimate approaches J as the number of trajectories "
-        "grows (P = 100 … 10000), while NBO's estimate stays biased",
-        ("LQG-2",),
-    ),
-    Statement(
-        "S8",
-        "Sec. III-B, Fig. 4",
-        "the UAV's average target location error falls gradually as N_T grows from 50 to 100 "
-        "to 250 (H = 6)",
-        ("UAV-1",),
-    ),
-    Statement(
-        "S9",
-        "Sec. III-B, Fig. 5",
-        "RS-MHP tracks the target with a lower average location error than NBO",
-        ("UAV-2",),
-        variants=("DEC-8a", "DEC-8b"),
+        "S9", "Sec. III-B, Fig. 5", WORDS("s9_says"), ("UAV-2",), variants=("DEC-8a", "DEC-8b")
     ),
 )
