@@ -33,6 +33,15 @@ rule's printed text and its evaluation come from the same :class:`~rsmhp.report.
   *supported*
   if the CI contains J and excludes :math:`J(\sigma^2/2)`; *not supported* if it excludes J;
   *inconclusive* otherwise (:data:`WEIGHTED_RULE`).
+* **LIN-1, Prop. 3 on its own premise** (linear dynamics, linear cost): z of the sample variance
+  of :math:`J_n` against :math:`C[\sum_k \mathcal{A}_k \Sigma \mathcal{A}_k^T]C^T/n` per n and
+  pooled, z of the mean per n, and the exceedances of :math:`|J_n - J| \ge k\,\mathrm{sd}_n`
+  against :math:`2\Phi(-k)` and :math:`1/k^2` (:data:`LINEAR_RULE`).
+
+Each claim is data (:class:`rsmhp.report.claimspec.ClaimSpec`: id, setup, rule, evidence
+function); its sentences, the rules' words and the key numbers' names are the macros of the
+template ``claims.md`` beside this module (:data:`WORDS`), filled with the numbers the evidence
+functions format.
 """
 
 from __future__ import annotations
@@ -43,14 +52,15 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
+from rsmhp.report.claimspec import ClaimSpec, Evidence
 from rsmhp.report.ledger import Claim, KeyNumber
 from rsmhp.report.markdown import fmt, fmt_ci
+from rsmhp.report.templates import Words
 from rsmhp.report.verdicts import Case, Facts, Rule, at_most, exceedance_facts, exceedance_rule
 from rsmhp.studies.lqg.summarise import (
     ChebyshevCheck,
     Fig3Check,
     LinearCostCheck,
-    NboErrorCheck,
     WeightedCheck,
     chebyshev_check,
     eps_label,
@@ -62,27 +72,45 @@ from rsmhp.studies.lqg.summarise import (
 __all__ = [
     "CHEBYSHEV_RULE",
     "FIG3_RULE",
+    "LINEAR_RULE",
+    "LIN_1",
+    "LQG_1",
+    "LQG_2",
+    "LQG_3",
+    "LQG_4",
     "PAPER_FIG3",
+    "SETUP",
     "WEIGHTED_RULE",
+    "WORDS",
     "chebyshev_claim",
+    "chebyshev_evidence",
     "chebyshev_facts",
     "ci_digits",
     "convergence_claims",
     "fig3_claim",
+    "fig3_evidence",
     "fig3_facts",
     "fmt_exact",
+    "linear_claim",
+    "linear_evidence",
+    "linear_facts",
     "lqg_claims",
     "nbo_error_claim",
+    "nbo_error_evidence",
     "nbo_error_rule",
     "weighted_claim",
+    "weighted_evidence",
     "weighted_facts",
 ]
 
+#: the words of the claims: the macros of ``claims.md`` beside this module
+WORDS = Words("rsmhp.studies.lqg", "claims.md")
+
 #: Sec. and figure of the paper this study replicates
-PAPER_FIG3 = "Sec. III-A, Fig. 3"
+PAPER_FIG3 = WORDS("paper_fig3")
 
 #: the setup of LQG-1..4: the paper's oven model (Sec. III-A)
-SETUP = "oven LQG (Sec. III-A)"
+SETUP = WORDS("setup")
 
 
 def fmt_exact(x: float, digits: int = 4) -> str:
@@ -109,6 +137,12 @@ def ci_digits(lo: float, hi: float, minimum: int = 3, maximum: int = 7) -> int:
     return int(min(max(d, minimum), maximum))
 
 
+def _finite(x: float, digits: int, scale: float = 1.0) -> str | None:
+    """``scale * x`` with ``digits`` significant digits, None where ``x`` is not finite (the
+    template then says so in words)."""
+    return fmt(scale * x, digits) if np.isfinite(x) else None
+
+
 # ------------------------------------------------------------------------------- LQG-1
 
 
@@ -117,46 +151,49 @@ def nbo_error_rule(z_limit: float, n_tests: int) -> Rule:
     return at_most(
         "max |z|",
         z_limit,
-        limit_text=f"{fmt(z_limit, 3)} (two-sided 95% familywise, Bonferroni over {n_tests} tests)",
-        basis="z = (simulated - closed form) / exact SE, SE = √(Var(g)/(P·R)), for each (a, H) "
-        "cell and for the paper's setting (all convergence trajectories pooled)",
+        limit_text=WORDS("lqg_1_rule_limit", z_limit=fmt(z_limit, 3), tests=n_tests),
+        basis=WORDS("lqg_1_rule_basis"),
     )
 
 
-def _nbo_error_measured(check: NboErrorCheck) -> str:
+def nbo_error_evidence(nbo: pd.DataFrame, conv: pd.DataFrame) -> Evidence:
+    r"""LQG-1 from the (a, H) grid and the paper's own setting: key number :math:`\max|z|`
+    over every test, judged by :func:`nbo_error_rule` of their Bonferroni limit; the paper's
+    setting is printed with its 95% interval :math:`\pm 1.96\,\mathrm{SE}`."""
+    check = nbo_error_check(nbo, conv)
     paper = check.paper
     half = 1.96 * paper.se
-    return (
-        f"paper's setting (a = {eps_label(paper.a)}, H = {paper.H}, {paper.n_trajectories} "
-        f"trajectories pooled): simulated {fmt(paper.simulated, 6)} "
-        f"{fmt_ci(paper.simulated - half, paper.simulated + half, 6)} vs closed form "
-        f"{fmt_exact(paper.closed, 6)}, z = {fmt(paper.z, 2, signed=True)}; grid of "
-        f"{check.n_cells} (a, H) cells ({check.replicates} replicates of P = {check.P}): "
-        f"largest |z| = {fmt(check.grid_max_abs_z, 3)} at a = {eps_label(check.worst_a)}, "
-        f"H = {check.worst_H}, largest |relative deviation| "
-        f"{fmt(100 * check.max_abs_rel_dev, 2)}%; any cell deviating from the closed "
-        f"form by more than {fmt(100 * check.resolution, 2)}% would cross the limit "
-        f"({fmt(check.z_limit, 3)} SE)"
+    return Evidence(
+        key=KeyNumber(WORDS("lqg_1_key", tests=check.n_tests), check.max_abs_z, digits=3),
+        facts={"max |z|": check.max_abs_z},
+        rule=nbo_error_rule(check.z_limit, check.n_tests),
+        values={
+            "a": eps_label(paper.a),
+            "H": paper.H,
+            "trajectories": paper.n_trajectories,
+            "simulated": fmt(paper.simulated, 6),
+            "ci": fmt_ci(paper.simulated - half, paper.simulated + half, 6),
+            "closed": fmt_exact(paper.closed, 6),
+            "z": fmt(paper.z, 2, signed=True),
+            "cells": check.n_cells,
+            "replicates": check.replicates,
+            "P": check.P,
+            "max_z": fmt(check.grid_max_abs_z, 3),
+            "worst_a": eps_label(check.worst_a),
+            "worst_H": check.worst_H,
+            "max_rel_dev": fmt(100 * check.max_abs_rel_dev, 2),
+            "resolution": fmt(100 * check.resolution, 2),
+            "z_limit": fmt(check.z_limit, 3),
+        },
     )
+
+
+LQG_1 = ClaimSpec(id="LQG-1", setup=SETUP, evidence=nbo_error_evidence, words=WORDS, check=True)
 
 
 def nbo_error_claim(nbo: pd.DataFrame, conv: pd.DataFrame) -> Claim:
     """Claim LQG-1: the NBO error formula, from the (a, H) grid and the paper's own setting."""
-    check = nbo_error_check(nbo, conv)
-    rule = nbo_error_rule(check.z_limit, check.n_tests)
-    return Claim(
-        id="LQG-1",
-        claim="In the oven LQG, NBO's error is J - J_NBO = r σ² Σ_{n<H} (1-a)^{2n} for every a "
-        "and H run",
-        paper="Sec. III-A: |J_NBO - J| = r σ² Σ_{n=0}^{H-1} (1-a)^{2n} (derived for H = 2, "
-        "stated for any H)",
-        key=KeyNumber(f"max |z| over {check.n_tests} tests", check.max_abs_z, digits=3),
-        verdict=rule.verdict({"max |z|": check.max_abs_z}),
-        rule=rule.text(),
-        measured=_nbo_error_measured(check),
-        setup=SETUP,
-        check=True,
-    )
+    return LQG_1.build(nbo, conv)
 
 
 # ------------------------------------------------------------------------------- LQG-2
@@ -165,8 +202,7 @@ FIG3_RULE = Rule(
     cases=(
         Case(
             "supported",
-            "the slope's 95% CI lies below 0, and at the largest P the RMSE's upper 95% limit "
-            "is below |J - J_NBO| and the 95% CI of the mean J_P contains J",
+            WORDS("lqg_2_rule_supported"),
             lambda f: (
                 f["slope_high"] < 0
                 and f["mean_low"] <= f["J"] <= f["mean_high"]
@@ -175,8 +211,7 @@ FIG3_RULE = Rule(
         ),
         Case(
             "not supported",
-            "the slope CI lies at/above 0, or at the largest P the CI of the mean J_P excludes "
-            "J (a bias that does not vanish) or the RMSE's lower limit reaches |J - J_NBO|",
+            WORDS("lqg_2_rule_not_supported"),
             lambda f: (
                 f["slope_low"] >= 0
                 or not f["mean_low"] <= f["J"] <= f["mean_high"]
@@ -202,53 +237,53 @@ def fig3_facts(check: Fig3Check) -> Facts:
     }
 
 
-def _fig3_measured(check: Fig3Check) -> str:
-    dm = ci_digits(check.ci_low, check.ci_high)
-    return (
-        f"slope {'contains' if check.fit.contains(-0.5) else 'excludes'} the theoretical -1/2 "
-        f"(theory: RMSE = √(Var(g)/P)); at P = {check.P}: mean J_P {fmt(check.mean, dm)} "
-        f"{fmt_ci(check.ci_low, check.ci_high, dm)} vs J = {fmt_exact(check.J, dm)}, "
-        f"RMSE {fmt(check.rmse, 3)} {fmt_ci(check.rmse_low, check.rmse_high, 3)} vs "
-        f"|J - J_NBO| = {fmt_exact(check.nbo_error, 4)} "
-        f"({fmt(check.nbo_error / check.rmse, 2)} times the RMSE); "
-        f"{check.n_P} values of P from {check.P_first} to {check.P}, "
-        f"{check.replicates} replicates each"
-    )
-
-
-def fig3_claim(summary: pd.DataFrame) -> Claim:
-    """Claim LQG-2 (Fig. 3 message): the RMSE of J_P falls with P, and at the largest P it is
-    below NBO's error and the mean shows no bias."""
+def fig3_evidence(summary: pd.DataFrame) -> Evidence:
+    r"""LQG-2 from the per-P summary: key number the slope :math:`s` of :math:`\log
+    \mathrm{RMSE} = c + s \log P` with its 95% CI (null 0, theory -1/2); at the largest P the
+    mean :math:`J_P` against J and the RMSE against :math:`|J - J_{NBO}|`."""
     check = fig3_check(summary)
     fit = check.fit
-    return Claim(
-        id="LQG-2",
-        claim="In the oven LQG at the paper's setting, the Monte-Carlo estimate J_P approaches "
-        "J as P grows while NBO's stays biased (Fig. 3)",
-        paper=f"{PAPER_FIG3}: MHP estimate close to J for P = 100..10000; NBO error high",
+    dm = ci_digits(check.ci_low, check.ci_high)
+    return Evidence(
         key=KeyNumber(
-            "slope of log RMSE vs log P",
+            WORDS("lqg_2_key"),
             fit.slope,
             fit.low,
             fit.high,
             digits=ci_digits(fit.low, fit.high),
             null=0.0,
         ),
-        verdict=FIG3_RULE.verdict(fig3_facts(check)),
-        rule=FIG3_RULE.text(),
-        measured=_fig3_measured(check),
-        setup=SETUP,
+        facts=fig3_facts(check),
+        values={
+            "slope_has_theory": fit.contains(-0.5),
+            "P": check.P,
+            "mean": fmt(check.mean, dm),
+            "ci": fmt_ci(check.ci_low, check.ci_high, dm),
+            "J": fmt_exact(check.J, dm),
+            "rmse": fmt(check.rmse, 3),
+            "rmse_ci": fmt_ci(check.rmse_low, check.rmse_high, 3),
+            "nbo_error": fmt_exact(check.nbo_error, 4),
+            "in_rmse": fmt(check.nbo_error / check.rmse, 2),
+            "n_P": check.n_P,
+            "P_first": check.P_first,
+            "replicates": check.replicates,
+        },
     )
+
+
+LQG_2 = ClaimSpec(id="LQG-2", setup=SETUP, evidence=fig3_evidence, words=WORDS, rule=FIG3_RULE)
+
+
+def fig3_claim(summary: pd.DataFrame) -> Claim:
+    """Claim LQG-2 (Fig. 3 message): the RMSE of J_P falls with P, and at the largest P it is
+    below NBO's error and the mean shows no bias."""
+    return LQG_2.build(summary)
 
 
 # ------------------------------------------------------------------------------- LQG-3
 
 
-CHEBYSHEV_RULE = exceedance_rule(
-    "per (P, ε) cell, the count of |J_P − J| ≥ ε over the replicates against its exact "
-    "probability (J_P: mean of P copies of the quadratic trajectory cost, a generalised "
-    "chi-square) and against Chebyshev's bound Var(g)/(P ε²)"
-)
+CHEBYSHEV_RULE = exceedance_rule(WORDS("lqg_3_rule_basis"))
 
 
 def chebyshev_facts(check: ChebyshevCheck) -> Facts:
@@ -256,66 +291,61 @@ def chebyshev_facts(check: ChebyshevCheck) -> Facts:
     return exceedance_facts(check.test, check.detectable)
 
 
-def _chebyshev_measured(check: ChebyshevCheck, eps_values: Sequence[float]) -> str:
-    eps_text = ", ".join(eps_label(e) for e in eps_values)
+def chebyshev_evidence(summary: pd.DataFrame, eps_values: Sequence[float]) -> Evidence:
+    r"""LQG-3 from the per-P summary and the configured ε: key number the smallest
+    Bonferroni-adjusted p-value of the exceedance tests; the largest ratio :math:`r` of the
+    exact probability to the bound where the bound is below 1 (the variance would have to be
+    :math:`1/r` times too small for Chebyshev's bound to fail) and the smallest spread error
+    detected with 80% power (both None where not finite)."""
+    check = chebyshev_check(summary, eps_values)
     t = check.test
-    power = (
-        f"the test detects a spread of J_P − J off by {fmt(100 * check.detectable, 2)}% "
-        "with 80% power in its most sensitive cell"
-        if np.isfinite(check.detectable)
-        else "no cell detects a spread error below 50% with 80% power"
+    return Evidence(
+        key=KeyNumber(WORDS("lqg_3_key", cells=check.n_cells), t.min_p, digits=3),
+        facts=chebyshev_facts(check),
+        values={
+            "cells": t.cells,
+            "eps": ", ".join(eps_label(e) for e in eps_values),
+            "replicates": check.replicates,
+            "departing": t.departing,
+            "above_bound": t.above_bound,
+            "min_p": fmt(t.min_p, 3),
+            "worst_P": check.worst_P,
+            "worst_eps": eps_label(check.worst_eps),
+            "worst_freq": fmt(check.worst_freq, 3),
+            "worst_exact": fmt(check.worst_exact, 3),
+            "ratio": _finite(t.max_exact_ratio, 2),
+            "informative": check.n_informative,
+            "inverse_ratio": _finite(1 / t.max_exact_ratio, 2),
+            "detectable": _finite(check.detectable, 2, scale=100),
+        },
     )
-    return (
-        f"{t.cells} (P, ε) cells, ε ∈ {{{eps_text}}}, {check.replicates} replicates per P; "
-        f"{t.departing} cells depart from the exact probability, {t.above_bound} lie "
-        f"significantly above the bound; smallest adjusted p = {fmt(t.min_p, 3)} at "
-        f"P = {check.worst_P}, ε = {eps_label(check.worst_eps)} (frequency "
-        f"{fmt(check.worst_freq, 3)} vs exact {fmt(check.worst_exact, 3)}); "
-        + (
-            f"exact probability at most {fmt(t.max_exact_ratio, 2)} × the bound in the "
-            f"{check.n_informative} cells where the bound is below 1 (the old Chebyshev-only "
-            f"test could fail only if the variance were about "
-            f"{fmt(1 / t.max_exact_ratio, 2)}× too small); "
-            if np.isfinite(t.max_exact_ratio)
-            else "no cell has a bound below 1; "
-        )
-        + power
-    )
+
+
+LQG_3 = ClaimSpec(
+    id="LQG-3",
+    setup=WORDS("lqg_3_setup"),
+    evidence=chebyshev_evidence,
+    words=WORDS,
+    rule=CHEBYSHEV_RULE,
+    part="beyond",
+    check=True,
+)
 
 
 def chebyshev_claim(summary: pd.DataFrame, eps_values: Sequence[float]) -> Claim:
     """Claim LQG-3 (Prop. 3 on the oven's quadratic cost): exceedances against the exact tail
     probability and against Chebyshev's bound."""
-    check = chebyshev_check(summary, eps_values)
-    return Claim(
-        id="LQG-3",
-        claim="In the oven LQG at the paper's setting, the Monte-Carlo estimate's error obeys "
-        "P(|J_P - J| ≥ ε) ≤ Var(g)/(P ε²), and its exceedances match the exact probability",
-        paper="Sec. II-A, Prop. 3: P(|J_N - J| ≥ ε) ≤ Var(p)/(N ε²) (Chebyshev; stated for a "
-        "linear cost, the bound holds for any finite variance)",
-        key=KeyNumber(
-            f"smallest adjusted p, exceedances vs exact probability ({check.n_cells} cells)",
-            check.test.min_p,
-            digits=3,
-        ),
-        verdict=CHEBYSHEV_RULE.verdict(chebyshev_facts(check)),
-        rule=CHEBYSHEV_RULE.text(),
-        measured=_chebyshev_measured(check, eps_values),
-        part="beyond",
-        setup=f"{SETUP}, quadratic cost (outside Prop. 3's linear premise)",
-        check=True,
-    )
+    return LQG_3.build(summary, eps_values)
 
 
 # ------------------------------------------------------------------------------- LQG-4
 
 WEIGHTED_RULE = Rule(
-    basis="at the largest P",
+    basis=WORDS("lqg_4_rule_basis"),
     cases=(
         Case(
             "supported",
-            "the weighted estimate's 95% CI contains J and excludes the derived limit J(σ²/2) "
-            "(Gaussian likeliness weights tilt N(0, σ²) to N(0, σ²/2))",
+            WORDS("lqg_4_rule_supported"),
             lambda f: (
                 f["ci_low"] <= f["J"] <= f["ci_high"]
                 and not f["ci_low"] <= f["limit"] <= f["ci_high"]
@@ -323,7 +353,7 @@ WEIGHTED_RULE = Rule(
         ),
         Case(
             "not supported",
-            "it excludes J",
+            WORDS("lqg_4_rule_not_supported"),
             lambda f: not f["ci_low"] <= f["J"] <= f["ci_high"],
         ),
     ),
@@ -336,53 +366,54 @@ def weighted_facts(check: WeightedCheck) -> Facts:
     return {"ci_low": check.ci_low, "ci_high": check.ci_high, "J": check.J, "limit": check.limit}
 
 
-def weighted_claim(summary: pd.DataFrame) -> Claim:
-    """Claim LQG-4 (Prop. 2, non-overlapping form): the weighted estimate at the largest P
-    against J and against the derived limit J(σ²/2)."""
+def weighted_evidence(summary: pd.DataFrame) -> Evidence:
+    r"""LQG-4 from the per-P summary: key number the weighted estimate at the largest P with
+    its 95% CI, against J and the derived limit :math:`J(\sigma^2/2)`."""
     check = weighted_check(summary)
     d = ci_digits(check.ci_low, check.ci_high)
-    return Claim(
-        id="LQG-4",
-        claim="In the oven LQG at the paper's setting, the likeliness-weighted average of "
-        "independent trajectories converges to J (Prop. 2, non-overlapping form)",
-        paper="Sec. II and II-A, Prop. 2: weighted average J~_N → J in probability",
+    return Evidence(
         key=KeyNumber(
-            f"weighted estimate at P = {check.P} (J = {fmt_exact(check.J, 4)})",
+            WORDS("lqg_4_key", P=check.P, J=fmt_exact(check.J, 4)),
             check.mean,
             check.ci_low,
             check.ci_high,
             digits=d,
         ),
-        verdict=WEIGHTED_RULE.verdict(weighted_facts(check)),
-        rule=WEIGHTED_RULE.text(),
-        measured=(
-            f"derived limit J(σ²/2) = J - r·Var(x_H)/2 = {fmt_exact(check.limit, d)} "
-            f"({'inside' if check.contains_limit else 'outside'} the CI); J = "
-            f"{fmt_exact(check.J, d)} ({'inside' if check.contains_j else 'outside'}); "
-            f"{check.replicates} replicates"
-        ),
-        setup=SETUP,
+        facts=weighted_facts(check),
+        values={
+            "limit": fmt_exact(check.limit, d),
+            "limit_inside": check.contains_limit,
+            "J": fmt_exact(check.J, d),
+            "J_inside": check.contains_j,
+            "replicates": check.replicates,
+        },
     )
+
+
+LQG_4 = ClaimSpec(
+    id="LQG-4", setup=SETUP, evidence=weighted_evidence, words=WORDS, rule=WEIGHTED_RULE
+)
+
+
+def weighted_claim(summary: pd.DataFrame) -> Claim:
+    """Claim LQG-4 (Prop. 2, non-overlapping form): the weighted estimate at the largest P
+    against J and against the derived limit J(σ²/2)."""
+    return LQG_4.build(summary)
 
 
 # ------------------------------------------------------------------------------- LIN-1
 
 LINEAR_RULE = Rule(
-    basis="Prop. 3's own setting (linear dynamics, linear cost): z of the sample variance of "
-    "J_n against the paper's formula C[Σ_k 𝒜_k Σ 𝒜_kᵀ]Cᵀ/n (chi-square, exact for Gaussian "
-    "J_n) per n and pooled, z of the mean against J per n; per (n, k) cell the count of "
-    "|J_n − J| ≥ k sd_n against its exact probability 2Φ(−k) and Chebyshev's 1/k²",
+    basis=WORDS("lin_1_rule_basis"),
     cases=(
         Case(
             "not supported",
-            "some |z| exceeds its Bonferroni limit (familywise 95%) or some cell's "
-            "exceedance frequency lies significantly above 1/k²",
+            WORDS("lin_1_rule_not_supported"),
             lambda f: f["max |z|"] > f["z limit"] or f["above bound"] >= 1,
         ),
         Case(
             "supported",
-            "every |z| is within the limit, no cell's count departs from the exact "
-            "probability and the exact probability is below 1/k² in every cell",
+            WORDS("lin_1_rule_supported"),
             lambda f: f["cells"] >= 1 and f["departing"] == 0 and f["exact above bound"] == 0,
         ),
     ),
@@ -399,39 +430,46 @@ def linear_facts(check: LinearCostCheck) -> Facts:
     }
 
 
+def linear_evidence(check: LinearCostCheck) -> Evidence:
+    """LIN-1 from the linear-cost check: key number the largest |z| of the ``2 len(n) + 1``
+    variance and mean tests; per n the z of the variance and of the mean (signed)."""
+    t = check.exceedance
+    return Evidence(
+        key=KeyNumber(WORDS("lin_1_key", tests=2 * len(check.n) + 1), check.max_abs_z),
+        facts=linear_facts(check),
+        values={
+            "H": check.H,
+            "replicates": check.replicates,
+            "var_prop3": fmt(check.var_prop3, 6),
+            "var_form": fmt(check.var_form, 6),
+            "zs": [
+                {"n": n, "var": fmt(v, 2, True), "mean": fmt(m, 2, True)}
+                for n, v, m in zip(check.n, check.var_z, check.mean_z, strict=True)
+            ],
+            "pooled_z": fmt(check.pooled_z, 2, True),
+            "z_limit": fmt(check.z_limit, 3),
+            "cells": t.cells,
+            "departing": t.departing,
+            "above_bound": t.above_bound,
+            "ratio": _finite(t.max_exact_ratio, 2),
+        },
+    )
+
+
+LIN_1 = ClaimSpec(
+    id="LIN-1",
+    # the horizon is filled from the evidence's values
+    setup=WORDS("lin_1_setup", H="{H}"),
+    evidence=linear_evidence,
+    words=WORDS,
+    rule=LINEAR_RULE,
+    check=True,
+)
+
+
 def linear_claim(check: LinearCostCheck) -> Claim:
     """Claim LIN-1: Prop. 3's variance formula and bound on a linear-cost system."""
-    zs = ", ".join(
-        f"n = {n}: {fmt(v, 2, True)} / {fmt(m, 2, True)}"
-        for n, v, m in zip(check.n, check.var_z, check.mean_z, strict=True)
-    )
-    t = check.exceedance
-    return Claim(
-        id="LIN-1",
-        claim="On a linear-cost system (Prop. 3's premise), the Monte-Carlo estimate's "
-        "variance is C[Σ_k 𝒜_k Σ 𝒜_kᵀ]Cᵀ/N and its error obeys Chebyshev's bound, with "
-        "exceedances matching the exact probability",
-        paper="Sec. II-A, Prop. 3: Var(p) = C[Σ_k 𝒜_k Σ 𝒜_kᵀ]Cᵀ and "
-        "P(|J_N - J| ≥ ε) ≤ Var(p)/(N ε²) for linear dynamics and a linear cost",
-        key=KeyNumber(
-            f"max |z| over {2 * len(check.n) + 1} variance and mean tests", check.max_abs_z
-        ),
-        verdict=LINEAR_RULE.verdict(linear_facts(check)),
-        rule=LINEAR_RULE.text(),
-        measured=f"H = {check.H}, {check.replicates} replicates per n; Var(p) = "
-        f"{fmt(check.var_prop3, 6)} by the paper's formula and {fmt(check.var_form, 6)} from "
-        f"the cost's quadratic form; z of the variance / of the mean: {zs}; pooled variance "
-        f"z = {fmt(check.pooled_z, 2, True)} (Bonferroni limit {fmt(check.z_limit, 3)}); "
-        f"{t.cells} (n, k) cells: {t.departing} depart from 2Φ(−k), {t.above_bound} lie "
-        f"significantly above 1/k²"
-        + (
-            f"; 2Φ(−k) is at most {fmt(t.max_exact_ratio, 2)} × 1/k²"
-            if np.isfinite(t.max_exact_ratio)
-            else ""
-        ),
-        setup=f"linear-cost 2-D system (LinearCost.example, H = {check.H})",
-        check=True,
-    )
+    return LIN_1.build(check)
 
 
 def convergence_claims(summary: pd.DataFrame, eps_values: Sequence[float]) -> list[Claim]:
