@@ -6,7 +6,8 @@
   so an installed plugin's family is checked here too;
 * it refuses faulty families, each with a message naming the family and the property: a
   toy family that passes is broken in one place at a time (weights that miss one by 1e-10,
-  an unknown colour key or a malformed hex colour, an invalid schema or default, a name of
+  an unknown colour key or a malformed hex colour, an invalid schema or default, an order
+  that is no int (which the registry refuses first), a name of
   another family, a job key without the name, a missing column, hypotheses that read the
   global random state, ignore the stream or are not made by their noise, controls out of
   bounds, a planner that keeps state between plans, a step that reports no work or less than
@@ -83,17 +84,12 @@ def test_the_global_random_state_is_left_as_it_was():
 @dataclass(frozen=True)
 class Toy(MonteCarlo):
     """A conforming toy family: Monte Carlo under other names (each fault below breaks it in
-    one place)."""
+    one place); its config key ``toy_nt`` and names ``toy_nt<N_T>`` follow from its family."""
 
     family: ClassVar[str] = "toy"
-    config_key: ClassVar[str] = "toy_nt"
     family_label: ClassVar[str] = "toy"
+    colour_key: ClassVar[str] = "rsmhp"
     order: ClassVar[int] = 90
-    name_pattern: ClassVar[str] = r"toy_nt(\d+)"
-
-    @property
-    def name(self) -> str:
-        return f"toy_nt{self.n_traj}"
 
 
 class BadWeights(Toy):
@@ -262,7 +258,6 @@ FAULTS = [
     (ShortHex, r"\[colour_key\] '#7a51' is neither a key of .* nor a hex colour '#rrggbb'"),
     (BadSchema, r"\[schema\] not a valid JSON Schema"),
     (BadDefault, r"\[default\] \[0\] is not valid against the schema"),
-    (BadOrder, r"\[class attributes\] order must be an int, got '90'"),
     (OthersName, r"\[names\] the name is also a name of family 'rsmhp'"),
     (KeyWithoutName, r"\[job_key\] job_key\(\)\['method'\] must be the name 'toy_nt4'"),
     (MissingColumn, r"\[columns\] columns\(\) must have exactly the keys \['N_T', 'N', 'M'\]"),
@@ -310,6 +305,15 @@ def test_a_fault_is_refused_naming_the_family_and_the_property(local_registry, c
     local_registry(cls)
     with pytest.raises(AssertionError, match=rf"'{cls.__name__}' \(family 'toy'\).*{message}"):
         check_method(cls)
+
+
+def test_a_family_the_registry_refuses_is_refused_by_the_check_too():
+    with pytest.raises(TypeError, match=r"class BadOrder .*'order' must be an int, got '90'"):
+        methods.register(BadOrder)
+    with pytest.raises(
+        AssertionError, match=r"\[class attributes\] order must be an int, got '90'"
+    ):
+        check_method(BadOrder)
 
 
 def test_an_unregistered_family_is_refused():

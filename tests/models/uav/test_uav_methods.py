@@ -175,6 +175,7 @@ def test_a_second_family_with_a_taken_key_is_refused():
 
     class Clash(MonteCarlo):
         family = "clash"
+        config_key = "rsmhp_nt"  # derived from family ("clash_nt") unless written
 
     with pytest.raises(ValueError, match=r"clashes with the registered MonteCarlo"):
         methods.register(Clash)

@@ -18,6 +18,10 @@ through this registry:
 * :func:`config_problems` collects the families' cross-field checks;
 * :func:`families` lists the registered families in order; :func:`baseline` is the family
   every comparison is made against.
+
+:func:`register` checks the class first: every attribute of the contract present (written,
+or derived from ``family``: :meth:`Method.derivations`), of the right type, and no abstract
+method left; a ``TypeError`` names the class and the attribute otherwise.
 """
 
 from __future__ import annotations
@@ -25,21 +29,30 @@ from __future__ import annotations
 import importlib
 import importlib.metadata
 import pkgutil
+import re
 import types
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import TYPE_CHECKING, Any
 
 if TYPE_CHECKING:
     import pandas as pd
 
-from rsmhp.models.uav.methods.base import COLUMNS, Hypotheses, Method
+from rsmhp.models.uav.methods.base import (
+    COLUMNS,
+    Hypotheses,
+    Method,
+    NTrajMethod,
+    OnOffMethod,
+)
 
 __all__ = [
     "COLUMNS",
     "PLUGIN_GROUP",
     "Hypotheses",
     "Method",
+    "NTrajMethod",
+    "OnOffMethod",
     "Plugin",
     "PluginError",
     "baseline",
@@ -121,12 +134,84 @@ def _origin(cls: type, new: bool = False) -> str:
     return f"package {cls.__module__.partition('.')[0]!r}"
 
 
+#: the class attributes every family has, written or derived, and what to write if one is
+#: missing (the contract: :mod:`rsmhp.models.uav.methods.base`)
+_REQUIRED = {
+    "family": "the family's identifier, e.g. 'rsmhp'",
+    "config_key": "derived from family unless written",
+    "schema": "the JSON Schema of the config value; an OnOffMethod writes description instead",
+    "default": "the config value when a methods block omits the key",
+    "family_label": "the family's human-readable name",
+    "colour_key": "derived from family unless written",
+    "order": "the family's position in tables and figures, an int",
+    "n_traj": "N_T, the tables' column: a field, a property or a constant",
+}
+_IDENTIFIER = re.compile(r"[A-Za-z0-9_]+")
+
+
+def _check_class(cls: type[Method]) -> None:
+    """``TypeError`` naming the class and the attribute if the family class lacks an
+    attribute of the contract, has one of the wrong type, or leaves an abstract method."""
+    where = f"method family class {cls.__qualname__} (module {cls.__module__})"
+    required = dict(_REQUIRED)
+    if getattr(cls.parse, "__func__", None) is Method.parse.__func__:
+        required["name_pattern"] = "the regular expression of the members' names, or own parse"
+    field_names = {f.name for f in fields(cls)} if hasattr(cls, "__dataclass_fields__") else set()
+    missing = [a for a in required if not hasattr(cls, a) and a not in field_names]
+    if missing:
+        listed = "; ".join(f"{a!r} ({required[a]})" for a in missing)
+        raise TypeError(
+            f"{where}: class attribute{'s' if len(missing) > 1 else ''} missing: {listed}"
+        )
+    if cls.__abstractmethods__:
+        raise TypeError(
+            f"{where}: abstract method(s) {sorted(cls.__abstractmethods__)} not implemented"
+        )
+
+    def wrong(attr: str, expected: str) -> TypeError:
+        return TypeError(
+            f"{where}: class attribute {attr!r} must be {expected}, got {getattr(cls, attr)!r}"
+        )
+
+    for attr in ("family", "config_key"):
+        v = getattr(cls, attr)
+        if not (isinstance(v, str) and _IDENTIFIER.fullmatch(v)):
+            raise wrong(attr, "a non-empty string of [A-Za-z0-9_]")
+    checks = {
+        "schema": (isinstance(cls.schema, Mapping), "a mapping (a JSON Schema)"),
+        "family_label": (
+            isinstance(cls.family_label, str) and cls.family_label.strip() != "",
+            "a non-empty string",
+        ),
+        "colour_key": (isinstance(cls.colour_key, str), "a string (a palette key or '#rrggbb')"),
+        "order": (isinstance(cls.order, int) and not isinstance(cls.order, bool), "an int"),
+        **{
+            a: (isinstance(getattr(cls, a), bool), "a bool")
+            for a in ("baseline", "uses_rng", "estimates_cost")
+        },
+    }
+    for attr, (ok, expected) in checks.items():
+        if not ok:
+            raise wrong(attr, expected)
+    pattern = getattr(cls, "name_pattern", None)
+    if pattern is not None:
+        if not isinstance(pattern, str):
+            raise wrong("name_pattern", "a string (a regular expression)")
+        try:
+            re.compile(pattern)
+        except re.error as e:
+            raise TypeError(f"{where}: class attribute 'name_pattern' {pattern!r}: {e}") from e
+
+
 def register(cls: type[Method]) -> type[Method]:
-    """Class decorator: add the family ``cls`` to the registry. Refuses a family or config
-    key that is already registered (by another class, naming the packages of both), a second
-    baseline, and a plugin family whose ``default`` configures members."""
+    """Class decorator: add the family ``cls`` to the registry. Refuses a class that misses
+    or mistypes an attribute of the contract (``TypeError`` naming the class and the
+    attribute), a family or config key that is already registered (by another class, naming
+    the packages of both), a second baseline, and a plugin family whose ``default``
+    configures members."""
     if not (isinstance(cls, type) and issubclass(cls, Method)):
         raise TypeError(f"register expects a Method subclass, got {cls!r}")
+    _check_class(cls)
     for other in _FAMILIES.values():
         # the same class again (its module imported or run again) replaces itself
         same = (other.__module__, other.__qualname__) == (cls.__module__, cls.__qualname__)

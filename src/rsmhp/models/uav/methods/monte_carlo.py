@@ -10,10 +10,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from rsmhp.core import guards
 from rsmhp.models.uav import target
 from rsmhp.models.uav.methods import register
-from rsmhp.models.uav.methods.base import Hypotheses, Method
+from rsmhp.models.uav.methods.base import Hypotheses, NTrajMethod
 from rsmhp.models.uav.planner import Belief
 
 __all__ = ["MonteCarlo"]
@@ -21,13 +20,10 @@ __all__ = ["MonteCarlo"]
 
 @register
 @dataclass(frozen=True)
-class MonteCarlo(Method):
+class MonteCarlo(NTrajMethod):
     """RS-MHP with ``n_traj`` = N_T independent hypotheses."""
 
-    n_traj: int
-
     family: ClassVar[str] = "rsmhp"
-    config_key: ClassVar[str] = "rsmhp_nt"
     schema: ClassVar[dict[str, Any]] = {
         "description": "N_T values of non-overlapping RS-MHP (independent hypotheses).",
         "type": "array",
@@ -37,29 +33,8 @@ class MonteCarlo(Method):
     }
     default: ClassVar[Any] = []
     family_label: ClassVar[str] = "RS-MHP"
-    colour_key: ClassVar[str] = "rsmhp"
     order: ClassVar[int] = 1
     closed_loop: ClassVar[str] = "drawn"
-    name_pattern: ClassVar[str] = r"rsmhp_nt(\d+)"
-
-    def __post_init__(self) -> None:
-        # whole-number floats become ints (1.0 and 1 already name the same random streams)
-        object.__setattr__(self, "n_traj", guards.positive_int("n_traj (N_T)", self.n_traj))
-
-    @classmethod
-    def from_config(cls, value: Any, path: str) -> list[Method]:
-        guards.instance_of(path, value, (list, tuple))
-        return [cls(guards.positive_int(f"{path}[{i}]", n)) for i, n in enumerate(value)]
-
-    @property
-    def name(self) -> str:
-        return f"rsmhp_nt{self.n_traj}"
-
-    def label(self) -> str:
-        return f"RS-MHP N_T={self.n_traj}"
-
-    def shade_size(self) -> int:
-        return self.n_traj
 
     def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator) -> Hypotheses:
         states, noise = target.draw_independent(

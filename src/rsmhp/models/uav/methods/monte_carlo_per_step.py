@@ -47,7 +47,6 @@ class MonteCarloPerStep(Method):
     }
     default: ClassVar[Any] = []
     family_label: ClassVar[str] = "RS-MHP N_T ∝ H"
-    colour_key: ClassVar[str] = "rsmhp_per_step"
     order: ClassVar[int] = 1
     closed_loop: ClassVar[str] = "drawn"
     name_pattern: ClassVar[str] = r"rsmhp_nt(\d+)h"

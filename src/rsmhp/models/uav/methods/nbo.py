@@ -9,10 +9,9 @@ from typing import Any, ClassVar
 
 import numpy as np
 
-from rsmhp.core import guards
 from rsmhp.models.uav import target
 from rsmhp.models.uav.methods import register
-from rsmhp.models.uav.methods.base import Hypotheses, Method
+from rsmhp.models.uav.methods.base import Hypotheses, OnOffMethod
 from rsmhp.models.uav.planner import Belief
 
 __all__ = ["NBO"]
@@ -23,33 +22,18 @@ _ONE.flags.writeable = False
 
 @register
 @dataclass(frozen=True)
-class NBO(Method):
+class NBO(OnOffMethod):
     """The nominal-belief planner (no fields)."""
 
     family: ClassVar[str] = "nbo"
-    config_key: ClassVar[str] = "nbo"
-    schema: ClassVar[dict[str, Any]] = {
-        "description": "Run the NBO planner (the baseline of every comparison).",
-        "type": "boolean",
-    }
+    description: ClassVar[str] = "Run the NBO planner (the baseline of every comparison)."
     default: ClassVar[Any] = True
     family_label: ClassVar[str] = "NBO"
-    colour_key: ClassVar[str] = "nbo"
     order: ClassVar[int] = 0
     closed_loop: ClassVar[str] = "nominal"
     baseline: ClassVar[bool] = True
     uses_rng: ClassVar[bool] = False
-    name_pattern: ClassVar[str] = "nbo"
     n_traj: ClassVar[int] = 1
-
-    @classmethod
-    def from_config(cls, value: Any, path: str) -> list[Method]:
-        guards.instance_of(path, value, (bool, np.bool_))
-        return [cls()] if value else []
-
-    @property
-    def name(self) -> str:
-        return "nbo"
 
     def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator | None) -> Hypotheses:
         H = setup.planner.horizon

@@ -30,7 +30,6 @@ class PrunedTree(Method):
     max_keep: int
 
     family: ClassVar[str] = "tree"
-    config_key: ClassVar[str] = "tree"
     schema: ClassVar[dict[str, Any]] = {
         "description": "Pruned-tree ablations (N draws per level, keep the M most likely).",
         "type": "array",
@@ -47,7 +46,7 @@ class PrunedTree(Method):
     }
     default: ClassVar[Any] = []
     family_label: ClassVar[str] = "pruned tree"
-    colour_key: ClassVar[str] = "pruned"
+    colour_key: ClassVar[str] = "pruned"  # the palette's "tree" is the unpruned tree's
     order: ClassVar[int] = 2
     closed_loop: ClassVar[str] = "drawn"
     name_pattern: ClassVar[str] = r"tree_n(\d+)_m(\d+)"

@@ -18,28 +18,18 @@ import numpy as np
 
 from rsmhp.core import designs, guards
 from rsmhp.models.uav.methods import register
-from rsmhp.models.uav.methods.base import Hypotheses, Method, from_design
+from rsmhp.models.uav.methods.base import Hypotheses, NTrajMethod, from_design
 from rsmhp.models.uav.planner import Belief
 
 __all__ = ["RQMC"]
 
 
-def _power_of_two(name: str, value: Any) -> int:
-    n = guards.positive_int(name, value)
-    if n & (n - 1):
-        raise ValueError(f"{name} must be a power of 2 (Sobol' points), got {n}")
-    return n
-
-
 @register
 @dataclass(frozen=True)
-class RQMC(Method):
+class RQMC(NTrajMethod):
     """Scrambled-Sobol' hypotheses, ``n_traj`` = N_T points (a power of 2)."""
 
-    n_traj: int
-
     family: ClassVar[str] = "rqmc"
-    config_key: ClassVar[str] = "rqmc_nt"
     schema: ClassVar[dict[str, Any]] = {
         "description": "N_T values (powers of 2) of RS-MHP with scrambled Sobol' hypotheses.",
         "type": "array",
@@ -52,15 +42,13 @@ class RQMC(Method):
     colour_key: ClassVar[str] = "sobol"
     order: ClassVar[int] = 3
     closed_loop: ClassVar[str] = "drawn"
-    name_pattern: ClassVar[str] = r"rqmc_nt(\d+)"
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "n_traj", _power_of_two("n_traj (N_T)", self.n_traj))
 
     @classmethod
-    def from_config(cls, value: Any, path: str) -> list[Method]:
-        guards.instance_of(path, value, (list, tuple))
-        return [cls(_power_of_two(f"{path}[{i}]", n)) for i, n in enumerate(value)]
+    def check_n_traj(cls, name: str, value: Any) -> int:
+        n = guards.positive_int(name, value)
+        if n & (n - 1):
+            raise ValueError(f"{name} must be a power of 2 (Sobol' points), got {n}")
+        return n
 
     @classmethod
     def config_problems(cls, value: Any, path: str, uav: Any) -> list[str]:
@@ -70,16 +58,6 @@ class RQMC(Method):
             for i, n in enumerate(value or [])
             if isinstance(n, int) and n >= 1 and n & (n - 1)
         ]
-
-    @property
-    def name(self) -> str:
-        return f"rqmc_nt{self.n_traj}"
-
-    def label(self) -> str:
-        return f"RQMC N_T={self.n_traj}"
-
-    def shade_size(self) -> int:
-        return self.n_traj
 
     def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator) -> Hypotheses:
         return from_design(belief, setup, designs.sobol, rng, self.n_traj)

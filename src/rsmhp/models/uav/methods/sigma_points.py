@@ -18,7 +18,7 @@ import numpy as np
 
 from rsmhp.core import designs, guards
 from rsmhp.models.uav.methods import register
-from rsmhp.models.uav.methods.base import Hypotheses, Method, from_design
+from rsmhp.models.uav.methods.base import Hypotheses, OnOffMethod, from_design
 from rsmhp.models.uav.planner import Belief
 
 __all__ = ["SigmaPoints", "n_points"]
@@ -31,36 +31,21 @@ def n_points(horizon: int) -> int:
 
 @register
 @dataclass(frozen=True)
-class SigmaPoints(Method):
+class SigmaPoints(OnOffMethod):
     """The cubature sigma points of the joint belief (no fields)."""
 
     family: ClassVar[str] = "sigma"
-    config_key: ClassVar[str] = "sigma"
-    schema: ClassVar[dict[str, Any]] = {
-        "description": "Run RS-MHP over the 8(H+1) cubature sigma points of the joint belief.",
-        "type": "boolean",
-    }
+    description: ClassVar[str] = (
+        "Run RS-MHP over the 8(H+1) cubature sigma points of the joint belief."
+    )
     default: ClassVar[Any] = False
     family_label: ClassVar[str] = "sigma points"
     colour_key: ClassVar[str] = "cubature"
     order: ClassVar[int] = 5
     closed_loop: ClassVar[str] = "drawn"
     uses_rng: ClassVar[bool] = False
-    name_pattern: ClassVar[str] = "sigma"
     #: the tables' N_T: 0, "set by the horizon" (n_points(H) hypotheses)
     n_traj: ClassVar[int] = 0
-
-    @classmethod
-    def from_config(cls, value: Any, path: str) -> list[Method]:
-        guards.instance_of(path, value, (bool, np.bool_))
-        return [cls()] if value else []
-
-    @property
-    def name(self) -> str:
-        return "sigma"
-
-    def label(self) -> str:
-        return "sigma points"
 
     def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator | None) -> Hypotheses:
         return from_design(belief, setup, designs.cubature)

@@ -188,7 +188,6 @@ class TreeSearch(Method):
     rollout: str = ROLLOUT
 
     family: ClassVar[str] = "dpw"
-    config_key: ClassVar[str] = "dpw"
     schema: ClassVar[dict[str, Any]] = {
         "description": (
             "Tree-search planners (PFT-DPW over Kalman beliefs): simulations per step and, "
@@ -212,7 +211,6 @@ class TreeSearch(Method):
     }
     default: ClassVar[Any] = []
     family_label: ClassVar[str] = "tree search"
-    colour_key: ClassVar[str] = "dpw"
     order: ClassVar[int] = 6
     name_pattern: ClassVar[str] = _PATTERN
     #: the tables' N_T: 0 (no fixed hypotheses; ``sims`` is the budget)
