@@ -33,7 +33,7 @@ from scipy.stats import qmc
 
 from rsmhp.core import guards
 from rsmhp.models.uav.methods import register
-from rsmhp.models.uav.methods.base import Hypotheses, Method, from_design
+from rsmhp.models.uav.methods.base import Hypotheses, NTrajMethod, from_design
 from rsmhp.models.uav.planner import Belief
 
 __all__ = ["Stratified", "latin_hypercube", "lhs_design"]
@@ -66,13 +66,14 @@ def lhs_design(
 
 @register
 @dataclass(frozen=True)
-class Stratified(Method):
-    """RS-MHP with ``n_traj`` = N_T Latin-hypercube-stratified hypotheses."""
+class Stratified(NTrajMethod):
+    """RS-MHP with ``n_traj`` = N_T Latin-hypercube-stratified hypotheses.
 
-    n_traj: int
+    An :class:`NTrajMethod` (members are values of N_T): from its ``family`` it takes the
+    config key ``lhs_nt``, the names ``lhs_nt<N_T>`` and their pattern, and the labels
+    ``LHS N_T=<N_T>``; it reads a config list of N_T (positive ints) with ``from_config``."""
 
     family: ClassVar[str] = "lhs"
-    config_key: ClassVar[str] = "lhs_nt"
     schema: ClassVar[dict[str, Any]] = {
         "description": "N_T values of RS-MHP with Latin-hypercube-stratified hypotheses.",
         "type": "array",
@@ -85,25 +86,6 @@ class Stratified(Method):
     family_label: ClassVar[str] = "LHS"
     colour_key: ClassVar[str] = "#4d7c0f"  # olive: a colour rsmhp's palette does not use
     order: ClassVar[int] = 7  # after the built-in families
-    name_pattern: ClassVar[str] = r"lhs_nt(\d+)"
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "n_traj", guards.positive_int("n_traj (N_T)", self.n_traj))
-
-    @classmethod
-    def from_config(cls, value: Any, path: str) -> list[Method]:
-        guards.instance_of(path, value, (list, tuple))
-        return [cls(guards.positive_int(f"{path}[{i}]", n)) for i, n in enumerate(value)]
-
-    @property
-    def name(self) -> str:
-        return f"lhs_nt{self.n_traj}"
-
-    def label(self) -> str:
-        return f"LHS N_T={self.n_traj}"
-
-    def shade_size(self) -> int:
-        return self.n_traj
 
     def hypotheses(self, belief: Belief, setup: Any, rng: np.random.Generator) -> Hypotheses:
         return from_design(belief, setup, lhs_design, rng, self.n_traj)
