@@ -1,7 +1,10 @@
-r"""Decision study on the UAV, claims DEC-6, DEC-7-<model>, DEC-8a/b: each a key number from
+r"""Decision study on the UAV, claims DEC-6, DEC-7-<model>, DEC-8a/b, each a
+:class:`~rsmhp.report.claimspec.ClaimSpec`: a key number from
 :mod:`rsmhp.studies.decisions.summarise_uav` and a verdict rule (:mod:`rsmhp.report.verdicts`)
-evaluated on facts; the rule's printed text and its evaluation are one object. Every key number is
-statistical (closed loop, optimiser).
+evaluated on facts, the rule's printed text and its evaluation one object; the claims'
+sentences, key-number names and the words of the rules are the macros of ``claims_uav.md``
+beside this module (:class:`~rsmhp.report.templates.Words`). Every key number is statistical
+(closed loop, optimiser).
 
 * **DEC-6** (the reconstruction, part "paper") and **DEC-7-<model>** (each model variant,
   part "beyond"), both by :func:`regret_rule`: d = relative regret of NBO − that of RS-MHP
@@ -28,9 +31,11 @@ import pandas as pd
 from rsmhp.models.uav import methods as registry
 from rsmhp.models.uav.methods import baseline_name, is_family
 from rsmhp.models.uav.methods.monte_carlo import MonteCarlo
+from rsmhp.report.claimspec import ClaimSpec, Evidence
 from rsmhp.report.ledger import Claim, KeyNumber
 from rsmhp.report.markdown import fmt, fmt_ci, param_text, range_text
 from rsmhp.report.palette import method_label
+from rsmhp.report.templates import Words
 from rsmhp.report.verdicts import Case, Facts, Rule, ci_side
 from rsmhp.studies.decisions.summarise_uav import (
     PairedRegret,
@@ -45,6 +50,7 @@ from rsmhp.studies.decisions.summarise_uav import (
 __all__ = [
     "DEC8_RULE",
     "KEY",
+    "WORDS",
     "ci_facts",
     "map_comparison",
     "map_contrary",
@@ -54,6 +60,9 @@ __all__ = [
     "regret_rule",
     "uav_claims",
 ]
+
+#: the words of the claims and rules (macros of ``claims_uav.md`` beside this module)
+WORDS = Words("rsmhp.studies.decisions", "claims_uav.md")
 
 #: the key number of every claim here, as the rules name it (facts ``mean d_low/high``)
 KEY = "mean d"
@@ -65,9 +74,6 @@ def pp(x: float) -> float:
     return float(100.0 * x)
 
 
-_REGRET_D = "d = relative regret of NBO − that of RS-MHP with the largest N_T, paired per belief"
-
-
 def regret_rule(margin_pp: float, setting: str) -> Rule:
     """The rule of DEC-6 (``setting`` "the reconstruction") and DEC-7 (a model variant):
     RS-MHP decides better than NBO, with the equivalence margin ±``margin_pp``."""
@@ -75,25 +81,23 @@ def regret_rule(margin_pp: float, setting: str) -> Rule:
         KEY,
         0.0,
         claimed="above",
-        basis=f"{_REGRET_D} state of {setting} (pp); 95% bootstrap CI",
+        basis=WORDS("regret_rule_basis", setting=setting),
         margin=margin_pp,
         margin_text=f"{param_text(margin_pp)} pp",
     )
 
 
 DEC8_RULE = Rule(
-    basis="d = closed-loop average location error of the map method fixed in the config "
-    "(decisions.claims.map_method) − NBO, "
-    "paired over runs; 95% bootstrap CIs",
+    basis=WORDS("dec_8_rule_basis"),
     cases=(
         Case(
             "supported",
-            "d's CI lies below 0 in every cell of the group and for d averaged over its cells",
+            WORDS("dec_8_rule_supported"),
             lambda f: f["cells below 0"] == f["cells"] and f[_HI] < 0,
         ),
         Case(
             "not supported",
-            "it lies above 0 in some cell or on average",
+            WORDS("dec_8_rule_not"),
             lambda f: f["cells above 0"] > 0 or f[_LO] > 0,
         ),
     ),
@@ -127,7 +131,7 @@ def _regret_key(method: str, d: PairedRegret, margin_pp: float) -> KeyNumber:
     """Key number of DEC-6/DEC-7: paired mean of NBO's − ``method``'s relative regret (pp)
     with its bootstrap CI over the ``d.n`` paired belief states, and the rule's margin."""
     return KeyNumber(
-        f"NBO − {method_label(method)} relative regret, paired mean",
+        WORDS("regret_key", label=method_label(method)),
         pp(d.mean),
         pp(d.low),
         pp(d.high),
@@ -140,11 +144,27 @@ def _regret_key(method: str, d: PairedRegret, margin_pp: float) -> KeyNumber:
     )
 
 
-def _margin_note(margin_pp: float, share: float) -> str:
-    return (
-        f"margin ±{param_text(margin_pp)} pp fixed in the config (decisions.claims); the "
-        f"optimiser alone leaves every method {fmt(pp(share), 3)}% above the best plan found"
-    )
+def _regret_evidence(
+    regret: pd.DataFrame,
+    model: str,
+    best_rs: str,
+    margin_pp: float,
+    setting: str,
+    seed: int,
+    n_boot: int,
+) -> Evidence:
+    """The evidence of DEC-6/DEC-7 on ``model`` (its rule's ``setting`` in words) with the
+    values both claims' texts share; the rule first: it checks the margin."""
+    rule = regret_rule(margin_pp, setting)
+    d = paired_regret(regret, model, best_rs, seed, n_boot)
+    key = _regret_key(best_rs, d, margin_pp)
+    values = {
+        "label": method_label(best_rs),
+        "states": str(d.n),
+        "margin": param_text(margin_pp),
+        "share": fmt(pp(optimiser_share(regret, model)), 3),
+    }
+    return Evidence(key=key, facts=ci_facts(key), values=values, rule=rule)
 
 
 def _dec6(
@@ -155,38 +175,22 @@ def _dec6(
     margin_pp: float,
     seed: int,
     n_boot: int,
-) -> Claim | None:
+) -> Evidence | None:
+    """NBO − the largest RS-MHP in open-loop relative regret on the reconstruction (DEC-6)."""
     nbo = summary[(summary["model"] == base) & (summary["method"] == baseline_name())]
     if nbo.empty:
         return None
     r = nbo.iloc[0]
-    rule = regret_rule(margin_pp, "the reconstruction")  # first: it checks the margin
-    d = paired_regret(regret, base, best_rs, seed, n_boot)
-    key = _regret_key(best_rs, d, margin_pp)
+    ev = _regret_evidence(regret, base, best_rs, margin_pp, WORDS("dec_6_setting"), seed, n_boot)
     sp = r["spearman_random"]
-    sp_txt = (
-        f"; Spearman rank correlation of NBO's cost with the evaluation cost over random "
-        f"plans {fmt(float(sp), 3)}"
-        if np.isfinite(sp)
-        else ""
-    )
-    return Claim(
-        "DEC-6",
-        f"On the UAV reconstruction, {method_label(best_rs)} chooses better plans than NBO "
-        "(lower open-loop relative regret)",
-        "Sec. II: NBO may generate severely sub-optimal controls (tested here on open-loop "
-        "plans of the paper's UAV setup)",
-        key,
-        rule.verdict(ci_facts(key)),
-        rule.text(),
-        measured=f"{d.n} belief states; NBO's mean relative regret "
-        f"{fmt(pp(r['mean_regret_rel']))}%, of which "
-        f"{fmt(pp(r['mean_regret_methods_rel']), 2)} pp against the best method's "
-        f"plan; {_margin_note(margin_pp, optimiser_share(regret, base))} (the multi-start on "
-        f"the evaluation cost finds better plans){sp_txt}",
-        part="paper",
-        setup=f"UAV reconstruction '{base}' (Sec. III-B), open-loop plans",
-    )
+    values = {
+        **ev.values,
+        "base": base,
+        "nbo_regret": fmt(pp(r["mean_regret_rel"])),
+        "vs_methods": fmt(pp(r["mean_regret_methods_rel"]), 2),
+        "spearman": fmt(float(sp), 3) if np.isfinite(sp) else "",
+    }
+    return Evidence(key=ev.key, facts=ev.facts, values=values, rule=ev.rule)
 
 
 def _dec7(
@@ -197,31 +201,21 @@ def _dec7(
     margin_pp: float,
     seed: int,
     n_boot: int,
-) -> Claim:
-    rule = regret_rule(margin_pp, "the model variant")  # first: it checks the margin
-    d = paired_regret(regret, model, best_rs, seed, n_boot)
+) -> Evidence:
+    """NBO − the largest RS-MHP in open-loop relative regret on a model variant (DEC-7)."""
+    ev = _regret_evidence(regret, model, best_rs, margin_pp, WORDS("dec_7_setting"), seed, n_boot)
     in_model = summary[summary["model"] == model]
     s_nbo = in_model[in_model["method"] == baseline_name()].iloc[0]
     s_rs = in_model[in_model["method"] == best_rs].iloc[0]
-    key = _regret_key(best_rs, d, margin_pp)
-    return Claim(
-        f"DEC-7-{model}",
-        f"On the UAV variant '{model}', {method_label(best_rs)} chooses better plans than "
-        "NBO (lower open-loop relative regret)",
-        "Sec. II: NBO may generate severely sub-optimal controls; tested on a "
-        "model variant (not the paper's model)",
-        key,
-        rule.verdict(ci_facts(key)),
-        rule.text(),
-        measured=f"{d.n} belief states; mean relative regret NBO "
-        f"{fmt(pp(s_nbo['mean_regret_rel']))}% vs {method_label(best_rs)} "
-        f"{fmt(pp(s_rs['mean_regret_rel']))}%; NBO's cost is constant over "
-        f"random plans at {int(s_nbo['spearman_random_undefined'])} of "
-        f"{int(s_nbo['n_states'])} states; "
-        f"{_margin_note(margin_pp, optimiser_share(regret, model))}",
-        part="beyond",
-        setup=f"UAV variant '{model}', open-loop plans",
-    )
+    values = {
+        **ev.values,
+        "model": model,
+        "nbo_regret": fmt(pp(s_nbo["mean_regret_rel"])),
+        "rs_regret": fmt(pp(s_rs["mean_regret_rel"])),
+        "constant": str(int(s_nbo["spearman_random_undefined"])),
+        "all_states": str(int(s_nbo["n_states"])),
+    }
+    return Evidence(key=ev.key, facts=ev.facts, values=values, rule=ev.rule)
 
 
 def map_comparison(map_df: pd.DataFrame, method: str = "") -> tuple[str, list[str]] | None:
@@ -252,101 +246,135 @@ def map_comparison(map_df: pd.DataFrame, method: str = "") -> tuple[str, list[st
     return chosen, [m for c, m in zip(comps, methods, strict=True) if c != chosen]
 
 
+def _axis(key: str, value: object) -> dict[str, str | None]:
+    """One axis of a map cell: its label and value (``None``: a footprint radius that is null,
+    no footprint; the ``map_cell`` macro)."""
+    unlimited = key == "sensor.footprint_radius" and pd.isna(value)
+    return {"label": axis_label(key), "value": None if unlimited else param_text(float(value))}
+
+
+def _contrary_cells(
+    map_df: pd.DataFrame, limited: pd.Series, flag: bool, method: str
+) -> list[dict[str, Any]]:
+    """The records of :func:`map_contrary` (the ``dec_8_contrary`` macro's)."""
+    methods = pd.Series([c.split(" − ")[0] for c in map_df["comparison"]], index=map_df.index)
+    family = type(registry.from_name(method))
+    rows = map_df[(limited == flag) & (map_df["ci_low"] > 0) & is_family(methods, family)]
+    return [
+        {
+            "row": _axis(r["row_key"], r["row_value"]),
+            "col": _axis(r["col_key"], r["col_value"]),
+            "label": method_label(r["comparison"].split(" − ")[0]),
+            "mean": fmt(r["mean_diff"], 3, True),
+            "ci": fmt_ci(r["ci_low"], r["ci_high"], 3, True),
+        }
+        for _, r in rows.iterrows()
+    ]
+
+
 def map_contrary(map_df: pd.DataFrame, limited: pd.Series, flag: bool, method: str) -> str:
     """Every (cell, comparison) of the group (``limited == flag``) whose 95% CI of method −
     NBO lies above 0 (significantly worse than NBO), for every method of the map of the same
     family as ``method`` (the compared one: e.g. every RS-MHP N_T)."""
-    methods = pd.Series([c.split(" − ")[0] for c in map_df["comparison"]], index=map_df.index)
-    family = type(registry.from_name(method))
-    rows = map_df[(limited == flag) & (map_df["ci_low"] > 0) & is_family(methods, family)]
-    return "; ".join(
-        f"{_cell_name(r)}: {method_label(r['comparison'].split(' − ')[0])} − NBO = "
-        f"{fmt(r['mean_diff'], 3, True)} {fmt_ci(r['ci_low'], r['ci_high'], 3, True)} m"
-        for _, r in rows.iterrows()
-    )
+    return WORDS("dec_8_contrary", contrary=_contrary_cells(map_df, limited, flag, method))
 
 
-def _cell_name(r: pd.Series) -> str:
-    def one(key: str, val: object) -> str:
-        unlimited = key == "sensor.footprint_radius" and pd.isna(val)
-        return f"{axis_label(key)} {'unlimited' if unlimited else param_text(float(val))}"
-
-    return f"{one(r['row_key'], r['row_value'])}, {one(r['col_key'], r['col_value'])}"
-
-
-def _dec8_claim(
-    cid: str, label: str, g: pd.Series, map_df: pd.DataFrame, others: str, contrary: str
-) -> Claim:
-    method = g["comparison"].split(" − ")[0]
+def _dec8_evidence(
+    g: pd.Series,
+    map_df: pd.DataFrame,
+    footprint: bool,
+    others: list[str],
+    contrary: list[dict[str, Any]],
+) -> Evidence:
+    """DEC-8a (``footprint``) or DEC-8b from the group row ``g`` of ``summarize_map_groups``:
+    the compared method − NBO in closed-loop average location error over the group's cells,
+    the map's ``others`` compared methods and the ``contrary`` cells."""
+    label = method_label(g["comparison"].split(" − ")[0])
     n_cells = int(g["n_cells"])
-    cells = range_text(pd.Series([g["cell_min"], g["cell_max"]]), 3, True)
-    regret_txt = (
-        f", open-loop relative regret {fmt(pp(g['regret_nbo']), 2)}% vs "
-        f"{fmt(pp(g['regret_method']), 2)}%"
-        if np.isfinite(g["regret_nbo"]) and np.isfinite(g["regret_method"])
-        else ""
+    regret = bool(np.isfinite(g["regret_nbo"]) and np.isfinite(g["regret_method"]))
+    key = KeyNumber(
+        WORDS("dec_8_key", label=label, cells=str(n_cells)),
+        float(g["mean_diff"]),
+        float(g["ci_low"]),
+        float(g["ci_high"]),
+        unit="m",
+        reproducible="statistical",
+        digits=3,
+        null=0.0,
+        # no n: the rule needs every cell of the group, so no one number of runs
+        # decides it (the runs per cell are in the measured text)
     )
-    row_key, col_key = map_df["row_key"].iloc[0], map_df["col_key"].iloc[0]
-    return Claim(
-        cid,
-        f"{label}, {method_label(method)} has lower closed-loop error than NBO in every map cell",
-        "Sec. III-B, Fig. 5: RS-MHP tracks better than NBO; here on model variants "
-        "(not the paper's model)",
-        KeyNumber(
-            f"{method_label(method)} − NBO average location error, paired "
-            f"mean over {n_cells} cells",
-            float(g["mean_diff"]),
-            float(g["ci_low"]),
-            float(g["ci_high"]),
-            unit="m",
-            reproducible="statistical",
-            digits=3,
-            null=0.0,
-            # no n: the rule needs every cell of the group, so no one number of runs
-            # decides it (the runs per cell are in the measured text)
-        ),
-        DEC8_RULE.verdict(map_facts(g)),
-        DEC8_RULE.text(),
-        measured=f"{axis_label(row_key)} × {axis_label(col_key)}, "
-        f"{int(g['n_runs'])} paired runs per cell; CI below 0 in "
-        f"{int(g['n_below'])} of {n_cells} cells, above 0 in {int(g['n_above'])}; "
-        f"cell means {cells} m; track loss NBO "
-        f"{fmt(pp(g['loss_nbo']), 2)}% vs {fmt(pp(g['loss_method']), 2)}%"
-        f"{regret_txt} (means over the cells); the compared method, {method_label(method)}, "
-        "is fixed in the config before the run (decisions.claims.map_method)",
-        dropped=(
-            f"the map's other comparisons ({others} − {method_label(baseline_name())}) are not "
-            "the key "
-            "number; cells where one of them lies on the opposite side are named as contrary"
-            if others
-            else ""
-        ),
-        part="beyond",
-        setup=f"UAV sensitivity map ({axis_label(row_key)} × {axis_label(col_key)}), "
-        + ("cells with a footprint" if cid == "DEC-8a" else "cells without a footprint"),
-        contrary=contrary,
-    )
+    values = {
+        "footprint": footprint,
+        "label": label,
+        "row": axis_label(map_df["row_key"].iloc[0]),
+        "col": axis_label(map_df["col_key"].iloc[0]),
+        "runs": str(int(g["n_runs"])),
+        "below": str(int(g["n_below"])),
+        "cells": str(n_cells),
+        "above": str(int(g["n_above"])),
+        "means": range_text(pd.Series([g["cell_min"], g["cell_max"]]), 3, True),
+        "loss_nbo": fmt(pp(g["loss_nbo"]), 2),
+        "loss_method": fmt(pp(g["loss_method"]), 2),
+        "regret_nbo": fmt(pp(g["regret_nbo"]), 2) if regret else "",
+        "regret_method": fmt(pp(g["regret_method"]), 2) if regret else "",
+        "others": [method_label(m) for m in others],
+        "baseline": method_label(baseline_name()),
+        "contrary": contrary,
+    }
+    return Evidence(key=key, facts=map_facts(g), values=values)
 
 
 def _dec8(
     map_df: pd.DataFrame, groups: pd.DataFrame, method: str, base_limited: bool
 ) -> list[Claim]:
+    """DEC-8a (cells with a footprint) and DEC-8b (without), each if the group was run."""
     chosen = None if map_df.empty or groups.empty else map_comparison(map_df, method)
     if chosen is None:
         return []
     comp, other_methods = chosen
     limited = limited_cells(map_df, base_limited)
     claims = []
-    for cid, flag, label in (
-        ("DEC-8a", True, "With a limited sensor footprint"),
-        ("DEC-8b", False, "Without a footprint (the reconstruction's sensor)"),
-    ):
+    for flag in (True, False):
         sel = groups[(groups["comparison"] == comp) & (groups["limited"] == flag)]
         if not sel.empty:
-            others = ", ".join(method_label(m) for m in other_methods)
-            contrary = map_contrary(map_df, limited, flag, comp.split(" − ")[0])
-            claims.append(_dec8_claim(cid, label, sel.iloc[0], map_df, others, contrary))
+            contrary = _contrary_cells(map_df, limited, flag, comp.split(" − ")[0])
+            ev = _dec8_evidence(sel.iloc[0], map_df, flag, other_methods, contrary)
+            claims.append(DEC8[flag].claim(ev))
     return claims
+
+
+#: DEC-6 on the reconstruction (its name in the setup)
+DEC6 = ClaimSpec(
+    id="DEC-6",
+    setup=WORDS("dec_6_setup", base="{base}"),
+    evidence=_dec6,
+    words=WORDS,
+)
+
+#: DEC-7 on each model variant (its name in the id and the setup)
+DEC7 = ClaimSpec(
+    id="DEC-7-{model}",
+    setup=WORDS("dec_7_setup", model="{model}"),
+    evidence=_dec7,
+    words=WORDS,
+    texts="dec_7",
+    part="beyond",
+)
+
+#: DEC-8a (cells with a footprint, key ``True``) and DEC-8b (without), on the map's axes
+DEC8 = {
+    flag: ClaimSpec(
+        id=cid,
+        setup=WORDS("dec_8_setup", row="{row}", col="{col}", footprint=flag),
+        evidence=_dec8_evidence,
+        words=WORDS,
+        rule=DEC8_RULE,
+        texts="dec_8",
+        part="beyond",
+    )
+    for cid, flag in (("DEC-8a", True), ("DEC-8b", False))
+}
 
 
 def uav_claims(
@@ -373,8 +401,10 @@ def uav_claims(
     if best_rs is not None:
         if base is not None:
             dec6 = _dec6(regret, summary, base, best_rs, margin, seed, n_boot)
-            claims += [dec6] if dec6 is not None else []
+            claims += [DEC6.claim(dec6)] if dec6 is not None else []
         claims += [
-            _dec7(regret, summary, m, best_rs, margin, seed, n_boot) for m in models if m != base
+            DEC7.claim(_dec7(regret, summary, m, best_rs, margin, seed, n_boot))
+            for m in models
+            if m != base
         ]
     return claims + _dec8(map_df, groups, str(rules.get("map_method", "")), base_limited)
