@@ -10,14 +10,15 @@ from pathlib import Path
 import pytest
 
 from rsmhp.pipeline.code_digest import describe
+from rsmhp.report import findings
 from rsmhp.report import statements as pp
 from rsmhp.report.templates import Words
 
 ROOT = Path(__file__).resolve().parents[2]
 REPORT = ROOT / "src/rsmhp/report"
 #: the report's templates and the macros' templates among them
-TEMPLATES = ("statements.md",)
-MACROS = ("statements.md",)
+TEMPLATES = ("statements.md", "findings.md", "main_claims.md")
+MACROS = ("statements.md", "main_claims.md")
 
 
 @pytest.mark.parametrize("name", TEMPLATES)
@@ -70,3 +71,21 @@ def test_a_statements_scope_in_words() -> None:
     assert pp.WORDS(
         "scope", on_paper="mixed", paper="A-1 supported", on_variants="equivalent", variants="V-1"
     ) == ("mixed on the paper's setups (A-1 supported); absent (equivalent) on the variants (V-1)")
+
+
+def test_main_claims_take_their_words_from_the_template() -> None:
+    source = (REPORT / "main_claims.md").read_text(encoding="utf-8")
+    macros = re.findall(r"\{% macro (says_\w+)\(\) %\}", source)
+    assert len(macros) == len(findings.MAIN_CLAIMS)
+    assert sorted(findings.WORDS(m) for m in macros) == sorted(m.says for m in findings.MAIN_CLAIMS)
+
+
+def test_power_and_best_read_as_sentences() -> None:
+    words = findings.WORDS
+    assert words("power", n=80, need=320, holm=True) == "n = 80, 320 for 80% power before Holm"
+    assert words("power", n=80, need=320, holm=False) == "n = 80, 320 for 80% power"
+    assert words("power_undecided", n=5) == "n = 5, no n decides it at this estimate"
+    cells = words("best_at", method="tree", cells="H = " + words("span", first="2", last="24"))
+    assert words("best_by", group="horizon", model="paper", cells=cells) == (
+        "by horizon on 'paper': tree at H = 2 to 24"
+    )

@@ -12,7 +12,9 @@ the appendix ledger; the checks of our own machinery
 :func:`verdict_text` says what a verdict means (an equivalence whose CI excludes the null:
 "difference significant but below Δ"). :func:`found_values` computes the preformatted values
 of the "What we found" sentences (``findings.md``, rendered by :mod:`rsmhp.report.render`);
-every sentence names the claims it rests on and links them.
+every sentence names the claims it rests on and links them. The words of this module (what each
+main claim says, how a verdict and its power read, which method is best where) are macros of
+``main_claims.md`` beside it (:data:`WORDS`).
 """
 
 from __future__ import annotations
@@ -28,10 +30,12 @@ from rsmhp.report.ledger import STATEMENT_VERDICTS, Claim
 from rsmhp.report.markdown import fmt, fmt_ci, param_text
 from rsmhp.report.power import runs_needed
 from rsmhp.report.statements import Judgement
+from rsmhp.report.templates import Words
 
 __all__ = [
     "MAIN_CLAIMS",
     "MAX_MAIN",
+    "WORDS",
     "MainClaim",
     "anchor",
     "best_sentence",
@@ -44,6 +48,9 @@ __all__ = [
 
 #: the most claims the main text shows
 MAX_MAIN = 10
+
+#: the words of the main text's claims and verdicts (``src/rsmhp/report/main_claims.md``)
+WORDS = Words("rsmhp.report", "main_claims.md")
 
 
 @dataclass(frozen=True)
@@ -58,54 +65,55 @@ class MainClaim:
     statement: str = ""
 
 
+#: the main text's claims (what each says: the macro ``says_<name>`` of :data:`WORDS`)
 MAIN_CLAIMS: tuple[MainClaim, ...] = (
     MainClaim(
         "NBO's plans",
-        "NBO, which ignores the noise, chooses worse controls than sampling (regret)",
+        WORDS("says_nbo_plans"),
         (("oven LQG", "DEC-1"), ("UAV paper", "DEC-6"), ("UAV footprint150", "DEC-7-footprint150")),
         "S1",
     ),
     MainClaim(
         "RS-MHP vs NBO",
-        "RS-MHP tracks the target with a lower closed-loop error than NBO",
+        WORDS("says_rsmhp_vs_nbo"),
         (("UAV paper", "UAV-2"), ("map, no footprint", "DEC-8b"), ("map, footprint", "DEC-8a")),
         "S9",
     ),
     MainClaim(
         "Weighting",
-        "the likeliness-weighted average converges to the expected cost J",
+        WORDS("says_weighting"),
         (("oven LQG", "LQG-4"), ("estimator problems", "EST-2")),
         "S3",
     ),
     MainClaim(
         "Pruning",
-        "keeping the M most likely trajectories degrades the approximation or the decisions",
+        WORDS("says_pruning"),
         (("estimator problems", "EST-4"), ("oven LQG decisions", "DEC-4"), ("UAV paper", "UAV-3")),
         "S5",
     ),
     MainClaim(
         "RQMC at 1 ms",
-        "at 1 ms of planning per step, tuned RQMC tracks better than tuned RS-MHP",
+        WORDS("says_rqmc"),
         (("UAV paper", "FR-1-paper"), ("UAV footprint150", "FR-1-footprint150")),
     ),
     MainClaim(
         "Sigma points at 1 ms",
-        "at 1 ms per step, tuned sigma points track no worse than RS-MHP (by 0.25 m)",
+        WORDS("says_sigma_points"),
         (("UAV paper", "FR-2-paper"), ("UAV footprint150", "FR-2-footprint150")),
     ),
     MainClaim(
         "Tree search at 1 ms",
-        "at 1 ms per step, the tuned tree search (PFT-DPW) tracks better than tuned RS-MHP",
+        WORDS("says_tree_search"),
         (("UAV paper", "FR-3-paper"), ("UAV footprint150", "FR-3-footprint150")),
     ),
     MainClaim(
         "NBO's error vs H",
-        "NBO's cost-approximation error grows with the horizon (H = 2 to 24)",
+        WORDS("says_nbo_error_h"),
         (("UAV paper", "HZ-1-paper"), ("UAV footprint150", "HZ-1-footprint150")),
     ),
     MainClaim(
         "Pruning vs H",
-        "the pruned tree's cost error grows with H faster than Monte Carlo's",
+        WORDS("says_pruning_h"),
         (
             ("oven LQG", "HZ-4"),
             ("UAV paper", "HZ-2-paper"),
@@ -114,7 +122,7 @@ MAIN_CLAIMS: tuple[MainClaim, ...] = (
     ),
     MainClaim(
         "Sampling's gain vs H",
-        "RS-MHP's closed-loop advantage over NBO grows with the horizon",
+        WORDS("says_sampling_gain_h"),
         (("UAV footprint150", "HZ-3-footprint150"),),
     ),
 )
@@ -151,11 +159,11 @@ def verdict_text(c: Claim) -> str:
     k = c.key
     m = _HOLM.search(c.rule)
     if c.verdict == "inconclusive" and m:
-        return f"inconclusive (after Holm, p = {m.group(1)}; {m.group(2)} without it)"
+        return WORDS("after_holm", p=m.group(1), without=m.group(2))
     if c.verdict == "equivalent" and k.has_ci and k.null is not None:
         if not k.ci_low <= k.null <= k.ci_high:
             delta = f"Δ = {fmt(k.margin, 3)}{' ' + k.unit if k.unit else ''}" if k.margin else "Δ"
-            return f"equivalent (difference significant but below {delta})"
+            return WORDS("significant_below", margin=delta)
     return c.verdict
 
 
@@ -165,9 +173,8 @@ def _power_text(c: Claim) -> str:
         return ""
     need = runs_needed(k)
     if need is None:
-        return f"; n = {k.n}, no n decides it at this estimate"
-    holm = " before Holm" if k.p_holm is not None else ""
-    return f"; n = {k.n}, {need} for 80% power{holm}"
+        return "; " + WORDS("power_undecided", n=k.n)
+    return "; " + WORDS("power", n=k.n, need=need, holm=k.p_holm is not None)
 
 
 def main_rows(claims: Sequence[Claim], appendix: str = "appendix.md") -> list[dict[str, str]]:
@@ -200,7 +207,7 @@ def _claim_phrase(c: Claim, appendix: str) -> str:
 
 
 def _span(values: Sequence[str], prefix: str, unit: str) -> str:
-    inner = values[0] if len(values) == 1 else f"{values[0]} to {values[-1]}"
+    inner = values[0] if len(values) == 1 else WORDS("span", first=values[0], last=values[-1])
     return f"{prefix}{inner}{unit}"
 
 
@@ -234,13 +241,13 @@ def best_sentence(best: pd.DataFrame | None) -> str:
                 unclear[-1][1] = pos
             else:
                 unclear.append([[value], pos])
-        segs = [f"{name} at {_span(vals, pre, post)}" for name, vals, _ in clear]
+        segs = [WORDS("best_at", method=name, cells=_span(v, pre, post)) for name, v, _ in clear]
         if unclear and not clear:
-            segs.append(f"no clear best in any of its {len(g)} cells")
+            segs.append(WORDS("no_best_anywhere", n=len(g)))
         elif unclear:
             spans = ", ".join(_span(u, pre, post) for u, _ in unclear)
-            segs.append(f"no clear best at {spans}")
-        parts.append(f"by {group} on '{model}': " + ", ".join(segs))
+            segs.append(WORDS("no_best_at", cells=spans))
+        parts.append(WORDS("best_by", group=group, model=model, cells=", ".join(segs)))
     return "; ".join(parts)
 
 
