@@ -39,6 +39,11 @@ Verdict rules
   every CI lies above 0 (every pruned estimate is biased toward the NBO cost); *not
   supported* if every CI contains 0; else *inconclusive*. Key number: the cell whose CI
   reaches nearest to J (the weakest evidence of a degradation).
+
+Each claim is data (:class:`rsmhp.report.claimspec.ClaimSpec`: id, setup, rule, evidence
+function); its sentences, the rules' words and the key numbers' names are the macros of the
+template ``claims.md`` beside this module (:data:`WORDS`), filled with the numbers the evidence
+functions format.
 """
 
 from __future__ import annotations
@@ -50,8 +55,10 @@ import numpy as np
 import pandas as pd
 
 from rsmhp.core.stats import ExceedanceTest, exceedance_test
+from rsmhp.report.claimspec import ClaimSpec, Evidence
 from rsmhp.report.ledger import Claim, KeyNumber
 from rsmhp.report.markdown import fmt, fmt_ci
+from rsmhp.report.templates import Words
 from rsmhp.report.verdicts import Case, Rule, exceedance_facts, exceedance_rule
 from rsmhp.studies.estimators.summarise import (
     MIN_TREE_SIZES,
@@ -66,15 +73,24 @@ from rsmhp.studies.estimators.summarise import (
 
 __all__ = [
     "COVERAGE_MIN",
+    "EST_1",
+    "EST_2",
+    "EST_3",
+    "EST_4",
     "RULE_EST1",
     "RULE_EST2",
     "RULE_EST4",
     "SETUP",
+    "WORDS",
     "claim_est1",
     "claim_est2",
     "claim_est3",
     "claim_est4",
     "claims",
+    "evidence_est1",
+    "evidence_est2",
+    "evidence_est3",
+    "evidence_est4",
     "facts_est1",
     "facts_est2",
     "facts_est3",
@@ -85,10 +101,13 @@ __all__ = [
     "sizes_text",
 ]
 
+#: the words of the claims: the macros of ``claims.md`` beside this module
+WORDS = Words("rsmhp.studies.estimators", "claims.md")
+
 #: share of tree cells whose bootstrap CI must contain the derived variance (EST-1)
 COVERAGE_MIN = 0.9
 #: the setup of EST-1..4: the paper's oven model at the estimator study's horizons
-SETUP = "oven LQG at H = 2..8 and a 4-D linear-Gaussian tracking model (estimator study)"
+SETUP = WORDS("setup")
 
 
 # --- text of numbers shared by the claims and the narrative ------------------------------
@@ -112,21 +131,24 @@ def k_text(k: float) -> str:
     return f"{float(k):g}"
 
 
+def _slope_row(problem: Any, slope: float, low: float, high: float) -> dict[str, Any]:
+    """A fitted slope printed: the problem, the slope (3 digits) and its 95% CI."""
+    return {"problem": problem, "slope": fmt(slope, 3), "ci": fmt_ci(low, high)}
+
+
 # --- the rules ------------------------------------------------------------------------------
 
 RULE_EST1 = Rule(
-    basis=f"OLS slope of log Var vs log N (95% CI) per problem run at >= {MIN_TREE_SIZES} tree "
-    "sizes",
+    basis=WORDS("est_1_rule_basis", sizes=MIN_TREE_SIZES),
     cases=(
         Case(
             "not supported",
-            "a slope CI lies above 0 or a variance rises significantly with N",
+            WORDS("est_1_rule_not_supported"),
             lambda f: f["slope_low_max"] > 0 or f["rising"] > 0,
         ),
         Case(
             "supported",
-            "every slope CI lies below 0 and the derived variance is inside >= "
-            f"{COVERAGE_MIN:.0%} of tree cells' bootstrap CIs",
+            WORDS("est_1_rule_supported", coverage=f"{COVERAGE_MIN:.0%}"),
             lambda f: (
                 f["counted"] > 0
                 and f["slope_high_max"] < 0
@@ -139,18 +161,16 @@ RULE_EST1 = Rule(
 )
 
 RULE_EST2 = Rule(
-    basis="f = (weighted mean - J)/(J(Σ/2) - J), bootstrap CI, at each problem's largest N "
-    "(0: J, 1: derived limit)",
+    basis=WORDS("est_2_rule_basis"),
     cases=(
         Case(
             "not supported",
-            "f's CI excludes 0 and f does not shrink with N in a problem with >= "
-            f"{MIN_TREE_SIZES} tree sizes",
+            WORDS("est_2_rule_not_supported", sizes=MIN_TREE_SIZES),
             lambda f: f["growing"] > 0,
         ),
         Case(
             "supported",
-            "every CI contains 0 and excludes 1",
+            WORDS("est_2_rule_supported"),
             lambda f: f["problems"] > 0 and f["at_j"] == f["problems"],
         ),
     ),
@@ -163,18 +183,16 @@ def rule_est3(ks: Sequence[float]) -> Rule:
     exceedance_rule` plus the 1/n rate of plain MC's variance."""
     base = exceedance_rule("")
     return Rule(
-        basis=f"Plain MC, ε = k·sd_n, k in {{{', '.join(k_text(k) for k in ks)}}}: per "
-        "(problem, n, k) cell the exceedance count vs its exact probability and vs 1/k² "
-        "(Chebyshev); Var-vs-n log-log slope per problem",
+        basis=WORDS("est_3_rule_basis", ks=", ".join(k_text(k) for k in ks)),
         cases=(
             Case(
                 "not supported",
-                f"{base.cases[0].when}, or a slope CI excludes -1",
+                WORDS("est_3_rule_not_supported", exceedance=base.cases[0].when),
                 lambda f: base.cases[0].test(f) or f["slopes_off"] > 0,
             ),
             Case(
                 "supported",
-                f"{base.cases[1].when}, and every slope CI contains -1",
+                WORDS("est_3_rule_supported", exceedance=base.cases[1].when),
                 lambda f: base.cases[1].test(f) and f["slopes"] > 0,
             ),
         ),
@@ -183,17 +201,16 @@ def rule_est3(ks: Sequence[float]) -> Rule:
 
 
 RULE_EST4 = Rule(
-    basis="Pruned tree (uniform) at the largest N: f = bias/(J_NBO - J) per (problem, M), "
-    "bootstrap CI (0: J, 1: the NBO cost)",
+    basis=WORDS("est_4_rule_basis"),
     cases=(
         Case(
             "supported",
-            "every CI lies above 0 (every pruned estimate is biased toward the NBO cost)",
+            WORDS("est_4_rule_supported"),
             lambda f: f["cells"] > 0 and f["above_zero"] == f["cells"],
         ),
         Case(
             "not supported",
-            "every CI contains 0 (no cell shows a degradation)",
+            WORDS("est_4_rule_not_supported"),
             lambda f: f["cells"] > 0 and f["contain_zero"] == f["cells"],
         ),
     ),
@@ -279,105 +296,94 @@ def facts_est4(top: pd.DataFrame) -> dict[str, float]:
 # --- EST-1 ------------------------------------------------------------------------------------
 
 
-def claim_est1(s: pd.DataFrame) -> Claim:
-    """EST-1 (Prop. 1) by :data:`RULE_EST1` (module docstring)."""
+def evidence_est1(s: pd.DataFrame) -> Evidence:
+    """EST-1 (Prop. 1): key number the counted slope whose CI reaches highest (null 0); the
+    counted slopes, the tree cells covering the derived variance, the problems whose variance
+    falls significantly, Var(shared tree)/Var(independent) at the largest leaf count, and the
+    problems left out of the slope evidence with why."""
     sl = tree_slopes(s)
     counted = sl[sl["counted"]]
     if len(counted):
         worst = counted.loc[counted["slope_high"].idxmax()]
         key = KeyNumber(
-            name=f"variance slope vs N, {worst['problem']} (weakest counted problem)",
+            name=WORDS("est_1_key", problem=worst["problem"]),
             value=float(worst["slope"]),
             ci_low=float(worst["slope_low"]),
             ci_high=float(worst["slope_high"]),
             null=0.0,
         )
     else:
-        key = KeyNumber(name=f"problems with >= {MIN_TREE_SIZES} tree sizes", value=0.0)
-    return Claim(
-        id="EST-1",
-        claim="On the estimator problems, the uniform average over the shared-draw tree "
-        "converges as N grows (Prop. 1)",
-        paper="Sec. II, Prop. 1: the uniform average over the tree's N^(H-1) trajectories "
-        "converges in probability to J",
+        key = KeyNumber(name=WORDS("est_1_key_none", sizes=MIN_TREE_SIZES), value=0.0)
+    covered, cells = tree_coverage(s)
+    return Evidence(
         key=key,
-        verdict=RULE_EST1.verdict(facts_est1(s)),
-        rule=RULE_EST1.text(),
-        measured=_measured_est1(s, sl),
-        dropped=_dropped_est1(sl),
-        setup=SETUP,
+        facts=facts_est1(s),
+        values={
+            "slopes": [
+                _slope_row(r["problem"], r["slope"], r["slope_low"], r["slope_high"])
+                for _, r in counted.iterrows()
+            ],
+            "covered": covered,
+            "cells": cells,
+            "falls": int(sl["falls"].sum()),
+            "multi": len(sl[sl["n_sizes"] > 1]),
+            "leaf_ratios": [
+                {
+                    "measured": fmt(r["ratio_measured"], 3),
+                    "derived": fmt(r["ratio_derived"], 3),
+                    "leaves": int(r["leaves"]),
+                    "problem": r["problem"],
+                    "N": r["N"],
+                }
+                for _, r in largest_leaf_ratios(s).iterrows()
+            ],
+            "problems": [_dropped_est1(r) for _, r in sl[~sl["counted"]].iterrows()],
+        },
     )
 
 
-def _measured_est1(s: pd.DataFrame, sl: pd.DataFrame) -> str:
-    counted = sl[sl["counted"]]
-    covered, total = tree_coverage(s)
-    measured = [
-        "variance slope vs N (derived law: -> -1): "
-        + ", ".join(
-            f"{r['problem']} {fmt(r['slope'], 3)} {fmt_ci(r['slope_low'], r['slope_high'])}"
-            for _, r in counted.iterrows()
-        )
-        if len(counted)
-        else "no problem has enough tree sizes for a slope",
-        f"derived tree variance inside the bootstrap 95% CI in {covered}/{total} tree cells",
-        f"variance significantly lower at the largest than at the smallest N in "
-        f"{int(sl['falls'].sum())}/{len(sl[sl['n_sizes'] > 1])} problems",
-    ]
-    head = largest_leaf_ratios(s)
-    if len(head):
-        measured.append(
-            "at the largest leaf count the shared tree's variance is "
-            + ", ".join(
-                f"{fmt(r['ratio_measured'], 3)}x (derived {fmt(r['ratio_derived'], 3)}x) that "
-                f"of {int(r['leaves'])} independent trajectories ({r['problem']}, N = {r['N']})"
-                for _, r in head.iterrows()
-            )
-        )
-    return "; ".join(measured)
+def _dropped_est1(r: pd.Series) -> dict[str, Any]:
+    """A problem left out of EST-1's slopes (too few tree sizes): its sizes and, where a slope
+    could be fitted, the slope with its CI and degrees of freedom (sizes - 2)."""
+    fitted = bool(np.isfinite(r["slope"]))
+    return {
+        "problem": r["problem"],
+        "H": r["H"],
+        "sizes": sizes_text(r["sizes"]),
+        "slope": fmt(r["slope"], 3) if fitted else None,
+        "ci": fmt_ci(r["slope_low"], r["slope_high"]) if fitted else None,
+        "dof": r["n_sizes"] - 2,
+        "admits_zero": bool(r["slope_low"] <= 0 <= r["slope_high"]),
+        "falls": bool(r["falls"]),
+    }
 
 
-def _dropped_est1(sl: pd.DataFrame) -> str:
-    dropped = []
-    for _, r in sl[~sl["counted"]].iterrows():
-        why = (
-            f"{r['problem']} (H = {r['H']}): ran only at N = {sizes_text(r['sizes'])} (N^H must "
-            "stay within max_leaves)"
-        )
-        if np.isfinite(r["slope"]):
-            why += (
-                f"; its slope {fmt(r['slope'], 3)} {fmt_ci(r['slope_low'], r['slope_high'])} "
-                f"has {r['n_sizes'] - 2} degree(s) of freedom"
-                + (" and admits 0" if r["slope_low"] <= 0 <= r["slope_high"] else "")
-            )
-        else:
-            why += "; no slope can be fitted"
-        if r["falls"]:
-            why += " (its variance does fall significantly from the smallest to the largest N)"
-        dropped.append(why)
-    dropped.append("tree_pernode cells: another sampler, not the tree of Prop. 1 (appendix tables)")
-    return "; ".join(dropped)
+EST_1 = ClaimSpec(id="EST-1", setup=SETUP, evidence=evidence_est1, words=WORDS, rule=RULE_EST1)
+
+
+def claim_est1(s: pd.DataFrame) -> Claim:
+    """EST-1 (Prop. 1) by :data:`RULE_EST1` (module docstring)."""
+    return EST_1.build(s)
 
 
 # --- EST-2 ------------------------------------------------------------------------------------
 
 
-def claim_est2(s: pd.DataFrame) -> Claim:
-    """EST-2 (Prop. 2) by :data:`RULE_EST2` from the weighted shared tree's f at each problem's
-    largest N (module docstring)."""
+def evidence_est2(s: pd.DataFrame) -> Evidence:
+    """EST-2 (Prop. 2) from the weighted shared tree's f at each problem's largest N (module
+    docstring): per problem the mean against J and J(Σ/2), f with its CI and f at the
+    smallest N; the problems with too few sizes to decide 'not supported'."""
     tr = weighted_trend(s)
-    return Claim(
-        id="EST-2",
-        claim="On the estimator problems, the likeliness-weighted average over the tree "
-        "converges to J (Prop. 2)",
-        paper="Sec. II, Prop. 2: the likeliness-weighted average over the tree converges in "
-        "probability to J",
+    return Evidence(
         key=_key_est2(tr),
-        verdict=RULE_EST2.verdict(facts_est2(s)),
-        rule=RULE_EST2.text(),
-        measured="; ".join(_measured_est2(p) for _, p in tr.iterrows()),
-        dropped=_dropped_est2(tr),
-        setup=SETUP,
+        facts=facts_est2(s),
+        values={
+            "problems": [_measured_est2(p) for _, p in tr.iterrows()],
+            "few": [
+                {"problem": p["problem"], "sizes": int(p["n_sizes"])}
+                for _, p in tr[tr["n_sizes"] < MIN_TREE_SIZES].iterrows()
+            ],
+        },
     )
 
 
@@ -391,9 +397,9 @@ def _key_est2(tr: pd.DataFrame) -> KeyNumber:
     elif rows:
         pick = max(rows, key=lambda p: float(p["f_high"]))
     else:
-        return KeyNumber(name="problems with a weighted tree", value=0.0)
+        return KeyNumber(name=WORDS("est_2_key_none"), value=0.0)
     return KeyNumber(
-        name=f"f, weighted tree, {pick['problem']} N = {int(pick['N'])}",
+        name=WORDS("est_2_key", problem=pick["problem"], N=int(pick["N"])),
         value=float(pick["f"]),
         ci_low=float(pick["f_low"]),
         ci_high=float(pick["f_high"]),
@@ -401,161 +407,158 @@ def _key_est2(tr: pd.DataFrame) -> KeyNumber:
     )
 
 
-def _measured_est2(p: pd.Series) -> str:
-    return (
-        f"{p['problem']} N = {int(p['N'])}: mean {fmt(p['mean'], 4)} "
-        f"{fmt_ci(p['ci_low'], p['ci_high'], 4)} vs J {fmt(p['J_exact'], 4)} and J(Σ/2) "
-        f"{fmt(p['limit'], 4)}, f = {fmt(p['f'], 3)} {fmt_ci(p['f_low'], p['f_high'])}"
-        + (
-            f" (N = {int(p['N_first'])}: f = {fmt(p['f_first'], 3)})"
-            if p["n_sizes"] > 1
-            else " (the only size run)"
-        )
-    )
+def _measured_est2(p: pd.Series) -> dict[str, Any]:
+    """One problem of EST-2 printed: mean with its CI against J and J(Σ/2), f with its CI at
+    the largest N, f at the smallest N (None if only one size ran)."""
+    more = p["n_sizes"] > 1
+    return {
+        "problem": p["problem"],
+        "N": int(p["N"]),
+        "mean": fmt(p["mean"], 4),
+        "ci": fmt_ci(p["ci_low"], p["ci_high"], 4),
+        "J": fmt(p["J_exact"], 4),
+        "limit": fmt(p["limit"], 4),
+        "f": fmt(p["f"], 3),
+        "f_ci": fmt_ci(p["f_low"], p["f_high"]),
+        "N_first": int(p["N_first"]) if more else None,
+        "f_first": fmt(p["f_first"], 3) if more else None,
+    }
 
 
-def _dropped_est2(tr: pd.DataFrame) -> str:
-    dropped = [
-        f"{p['problem']} ({int(p['n_sizes'])} tree size(s)) cannot decide 'not supported' "
-        "alone: too few sizes to see whether the bias shrinks (it still enters the 'supported' "
-        "test)"
-        for _, p in tr[tr["n_sizes"] < MIN_TREE_SIZES].iterrows()
-    ]
-    dropped.append(
-        "weighted mc and tree_pernode: not the estimator of Prop. 2 (appendix table; same "
-        "limit J(Σ/2))"
-    )
-    return "; ".join(dropped)
+EST_2 = ClaimSpec(id="EST-2", setup=SETUP, evidence=evidence_est2, words=WORDS, rule=RULE_EST2)
+
+
+def claim_est2(s: pd.DataFrame) -> Claim:
+    """EST-2 (Prop. 2) by :data:`RULE_EST2` from the weighted shared tree's f at each problem's
+    largest N (module docstring)."""
+    return EST_2.build(s)
 
 
 # --- EST-3 ------------------------------------------------------------------------------------
+
+
+def evidence_est3(s: pd.DataFrame, cheb: pd.DataFrame) -> Evidence:
+    """EST-3 (Prop. 3) by :func:`rule_est3` of the multipliers run: key number the smallest
+    adjusted p of plain MC's exceedances against the exact probability; the cell of that p,
+    the largest ratio of the exact probability to the bound (1 where none is finite), the
+    smallest spread error detected with 80% power (None without power) and the variance-vs-n
+    slopes."""
+    ks = sorted(cheb["k"].unique()) if len(cheb) else []
+    rule = rule_est3(ks)
+    facts = facts_est3(cheb, s)
+    if not len(cheb):
+        return Evidence(
+            key=KeyNumber(name=WORDS("est_3_key_none"), value=0.0),
+            facts=facts,
+            rule=rule,
+            values={"cells": None},
+        )
+    test = _exceedance(cheb)
+    worst = cheb.iloc[test.worst]
+    det = float(cheb["detectable"].min())
+    ratio = test.max_exact_ratio
+    return Evidence(
+        key=KeyNumber(name=WORDS("est_3_key", cells=test.cells), value=test.min_p),
+        facts=facts,
+        rule=rule,
+        values={
+            "cells": test.cells,
+            "departing": test.departing,
+            "above_bound": test.above_bound,
+            "problem": worst["problem"],
+            "n": int(worst["n"]),
+            "k": k_text(worst["k"]),
+            "freq": fmt(worst["freq"], 3),
+            "exact": fmt(worst["exact"], 3),
+            "ratio": fmt(ratio, 2) if np.isfinite(ratio) else 1,
+            "detectable": fmt(100 * det, 2) if np.isfinite(det) else None,
+            "slopes": [
+                _slope_row(p, f.slope, f.low, f.high) for p, f in mc_variance_slopes(s).items()
+            ],
+        },
+    )
+
+
+EST_3 = ClaimSpec(
+    id="EST-3",
+    setup=WORDS("est_3_setup"),
+    evidence=evidence_est3,
+    words=WORDS,
+    part="beyond",
+    check=True,
+)
 
 
 def claim_est3(s: pd.DataFrame, cheb: pd.DataFrame) -> Claim:
     """EST-3 (Prop. 3) by :func:`rule_est3`: exceedances of plain MC against the exact
     probability and Chebyshev's bound (:func:`~rsmhp.studies.estimators.summarise.chebyshev_table`),
     and its variance-vs-n slopes."""
-    ks = sorted(cheb["k"].unique()) if len(cheb) else []
-    facts = facts_est3(cheb, s)
-    rule = rule_est3(ks)
-    rate = mc_variance_slopes(s)
-    test = _exceedance(cheb) if len(cheb) else None
-    if test is None:
-        key = KeyNumber(name="exceedance cells", value=0.0)
-        measured = "no plain-MC cell"
-    else:
-        worst = cheb.iloc[test.worst]
-        key = KeyNumber(
-            name=f"smallest adjusted p, exceedances vs exact probability ({test.cells} cells)",
-            value=test.min_p,
-        )
-        det = float(cheb["detectable"].min())
-        measured = (
-            f"{test.departing} of {test.cells} cells depart from the exact probability, "
-            f"{test.above_bound} lie significantly above 1/k²; smallest adjusted p at "
-            f"{worst['problem']} n = {int(worst['n'])} k = {k_text(worst['k'])} (frequency "
-            f"{fmt(worst['freq'], 3)} vs exact {fmt(worst['exact'], 3)}); exact probability at "
-            f"most {fmt(test.max_exact_ratio, 2) if np.isfinite(test.max_exact_ratio) else 1} × "
-            "the bound; "
-            + (
-                f"the most sensitive cell detects a spread error of {fmt(100 * det, 2)}% "
-                "with 80% power"
-                if np.isfinite(det)
-                else "no cell detects a spread error below 50% with 80% power (too few replicates)"
-            )
-            + (
-                "; variance slope vs n: "
-                + ", ".join(
-                    f"{p} {fmt(f.slope, 3)} {fmt_ci(f.low, f.high)}" for p, f in rate.items()
-                )
-                if rate
-                else "; no variance slope (fewer than 3 budgets)"
-            )
-        )
-    return Claim(
-        id="EST-3",
-        claim="On the estimator problems, plain Monte Carlo's error obeys P(|J_n - J| >= ε) "
-        "<= Var/(n ε²), its exceedances match the exact probability, and its variance falls "
-        "as 1/n",
-        paper="Sec. II-A, Prop. 3: for linear dynamics and cost, P(|J_N - J| >= ε) <= "
-        "Var(p)/(N ε²) (Chebyshev; the bound holds for any finite variance)",
-        key=key,
-        verdict=rule.verdict(facts),
-        rule=rule.text(),
-        measured=measured,
-        part="beyond",
-        setup=f"{SETUP}, quadratic costs (outside Prop. 3's linear premise)",
-        check=True,
-    )
+    return EST_3.build(s, cheb)
 
 
 # --- EST-4 ------------------------------------------------------------------------------------
 
 
-def claim_est4(s: pd.DataFrame) -> Claim:
-    """EST-4 (pruning) by :data:`RULE_EST4`: bias / (J_NBO - J) of the uniform pruned tree at
-    the largest N, per (problem, M)."""
+def evidence_est4(s: pd.DataFrame) -> Evidence:
+    """EST-4 (pruning): bias / (J_NBO - J) of the uniform pruned tree at the largest N, per
+    (problem, M); key number the cell whose CI reaches nearest to J (the weakest evidence of a
+    degradation, null 0); per problem the range of the fraction, the leaves the full tree
+    would have, N^H, against the M kept, and the largest gap to the weighted pruned cells."""
     top = pruning_at_largest_n(s)
-    if len(top):
-        # the weakest evidence of a degradation: the cell whose CI reaches nearest to J
-        r = top.loc[top["bias_fraction_low"].idxmin()]
+    near = top.loc[top["bias_fraction_low"].idxmin()] if len(top) else None
+    if near is not None:
         key = KeyNumber(
-            name=f"bias / (J_NBO - J), pruned, {r['problem']} N = {int(r['N'])} M = {int(r['M'])}",
-            value=float(r["bias_fraction_of_nbo"]),
-            ci_low=float(r["bias_fraction_low"]),
-            ci_high=float(r["bias_fraction_high"]),
+            name=WORDS("est_4_key", problem=near["problem"], N=int(near["N"]), M=int(near["M"])),
+            value=float(near["bias_fraction_of_nbo"]),
+            ci_low=float(near["bias_fraction_low"]),
+            ci_high=float(near["bias_fraction_high"]),
             digits=4,
             null=0.0,
         )
     else:
-        key = KeyNumber(name="pruned cells", value=0.0)
-    dropped = ["pruned trees below the largest N (the claim concerns growing N; appendix table)"]
+        key = KeyNumber(name=WORDS("est_4_key_none"), value=0.0)
     gap = pruning_weighting_gap(s)
-    if gap is not None:
-        dropped.append(
-            f"likeliness-weighted pruned cells: within {fmt(gap, 2)} of the uniform ones in "
-            "every cell (the M kept trajectories have nearly equal likeliness)"
-        )
-    return Claim(
-        id="EST-4",
-        claim="On the estimator problems, pruning the tree to its M most likely "
-        "trajectories degrades the approximation of J: the pruned estimate is biased toward "
-        "the NBO cost",
-        paper="Sec. II: keep the M most likely trajectories per step to stop exponential "
-        "growth; Sec. III-B: pruning would degrade the performance but save computation",
+    by_problem = top.groupby("problem", sort=False)
+    return Evidence(
         key=key,
-        verdict=RULE_EST4.verdict(facts_est4(top)),
-        rule=RULE_EST4.text(),
-        measured=_measured_est4(top),
-        dropped="; ".join(dropped),
-        setup=SETUP,
+        facts=facts_est4(top),
+        values={
+            "sizes": sizes_text(sorted(top["N"].unique())),
+            "ms": sizes_text(sorted(top["M"].unique())),
+            "problems": [
+                {"problem": p, "range": range_text(g["bias_fraction_of_nbo"], 3)}
+                for p, g in by_problem
+            ],
+            "near": None
+            if near is None
+            else {
+                "problem": near["problem"],
+                "M": int(near["M"]),
+                "f": fmt(near["bias_fraction_of_nbo"], 3),
+                "ci": fmt_ci(near["bias_fraction_low"], near["bias_fraction_high"]),
+            },
+            "compute": [
+                {
+                    "problem": p,
+                    "N": int(g["N"].iloc[0]),
+                    "M": int(g["M"].max()),
+                    "leaves": f"{float(g['N'].iloc[0]) ** int(g['H'].iloc[0]):.3g}",
+                }
+                for p, g in by_problem
+                if "H" in top.columns
+            ],
+            "gap": None if gap is None else fmt(gap, 2),
+        },
     )
 
 
-def _measured_est4(top: pd.DataFrame) -> str:
-    summary = ", ".join(
-        f"{p} {range_text(g['bias_fraction_of_nbo'], 3)}"
-        for p, g in top.groupby("problem", sort=False)
-    )
-    if len(top):
-        near = top.loc[top["bias_fraction_low"].idxmin()]
-        summary += (
-            f"; CI reaching nearest to J: {near['problem']} M = {int(near['M'])}, "
-            f"{fmt(near['bias_fraction_of_nbo'], 3)} "
-            f"{fmt_ci(near['bias_fraction_low'], near['bias_fraction_high'])}"
-        )
-    ms = ", ".join(str(int(m)) for m in sorted(top["M"].unique()))
-    compute = ", ".join(
-        f"{p} N = {int(g['N'].iloc[0])}: at most {int(g['M'].max())} of "
-        f"{float(g['N'].iloc[0]) ** int(g['H'].iloc[0]):.3g} leaves"
-        for p, g in top.groupby("problem", sort=False)
-        if "H" in top.columns
-    )
-    return (
-        f"bias / (J_NBO - J) at N = {sizes_text(sorted(top['N'].unique()))}, M = {ms}: "
-        f"{summary}; derived limit for N -> infinity with M fixed: the NBO cost (fraction 1)"
-        + (f"; compute: the pruned tree keeps e.g. {compute}" if compute else "")
-    )
+EST_4 = ClaimSpec(id="EST-4", setup=SETUP, evidence=evidence_est4, words=WORDS, rule=RULE_EST4)
+
+
+def claim_est4(s: pd.DataFrame) -> Claim:
+    """EST-4 (pruning) by :data:`RULE_EST4`: bias / (J_NBO - J) of the uniform pruned tree at
+    the largest N, per (problem, M)."""
+    return EST_4.build(s)
 
 
 def claims(s: pd.DataFrame, cheb: pd.DataFrame) -> list[Claim]:
