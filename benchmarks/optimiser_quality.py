@@ -57,7 +57,7 @@ def main() -> None:
     args = ap.parse_args()
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     base = UAVSetup.from_config(cfg["uav"])
-    models_cfg = {m["name"]: m for m in cfg["decisions"]["uav"]["models"]}
+    models_cfg = {m["name"]: m for m in cfg["uav_models"]}
     variant = {**cfg["uav"]["sensor"], **models_cfg["footprint150"]["sensor"]}
     models = {
         "paper": base,

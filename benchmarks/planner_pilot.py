@@ -3,7 +3,7 @@ step of every planner family at several sizes, on the decision study's belief st
 
     .venv/bin/python benchmarks/planner_pilot.py [--runs 4] [--models paper footprint150]
 
-For each model variant of ``decisions.uav.models`` named, the belief states of the first
+For each model variant of ``uav_models`` named, the belief states of the first
 ``--runs`` NBO closed-loop runs at ``decisions.uav.steps`` (the decision study's states and
 streams), every method below plans once and is scored exactly as ``decisions_uav`` scores
 (:func:`rsmhp.models.uav.scoring.score_state`: regret against the multi-start reference

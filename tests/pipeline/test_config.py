@@ -117,18 +117,28 @@ def test_bad_uav_values_are_named(path, value, expected):
         ("decisions.lqg.replicates", 1, r"decisions\.lqg\.replicates: 1 "),
         ("decisions.lqg.methods", ["greedy"], r"decisions\.lqg\.methods\[0\]: 'greedy'"),
         # decisions.uav
-        ("decisions.uav.models", [{"name": "Bad Name"}], r"decisions\.uav\.models\[0\]\.name"),
+        # uav_models (the model variants every UAV study reads)
+        ("uav_models", [{"name": "Bad Name"}], r"uav_models\[0\]\.name"),
         (
-            "decisions.uav.models",
+            "uav_models",
             [{"name": "x", "sensor": {"footprint_radius": -5}}],
-            r"decisions\.uav\.models\[0\]\.sensor\.footprint_radius: -5",
+            r"uav_models\[0\]\.sensor\.footprint_radius: -5",
         ),
         (
-            "decisions.uav.models",
+            "uav_models",
             [{"name": "x", "planner": {"horizon": 3}}],
-            r"decisions\.uav\.models\[0\]\.planner: unknown key",
+            r"uav_models\[0\]\.planner: unknown key",
         ),
-        ("decisions.uav.models", [{"name": "a"}, {"name": "a"}], r"duplicate name"),
+        ("uav_models", [{"name": "a"}, {"name": "a"}], r"uav_models: duplicate name"),
+        # the key it moved from is refused with where it went
+        (
+            "decisions.uav.models",
+            [{"name": "paper"}],
+            r"decisions\.uav\.models: this key moved to uav_models",
+        ),
+        # scenarios
+        ("scenarios.bootstrap", 10, r"scenarios\.bootstrap: 10 .*\[100, 1000000\]"),
+        # decisions.uav
         ("decisions.uav.runs", 0, r"decisions\.uav\.runs: 0 "),
         ("decisions.uav.steps", [0, 60], r"decisions\.uav\.steps: \[60\] not before"),
         ("decisions.uav.n_eval", 5, r"decisions\.uav\.n_eval: 5 "),

@@ -12,6 +12,7 @@ and ``from ... import`` of every module, at module level or inside functions, pa
 from __future__ import annotations
 
 import ast
+import re
 from pathlib import Path
 
 import pytest
@@ -114,3 +115,153 @@ def test_the_rules_catch_a_crossing(tmp_path):
     finally:
         SRC = saved
     assert "rsmhp.studies.lqg.claims" in found and _study("rsmhp.studies.lqg.claims") == "lqg"
+
+
+# ------------------------------------------------------------------ a study's code in its folder
+
+
+def test_the_layers_below_never_import_a_study():
+    """core, models, pipeline and report never import a study by name: the pipeline finds the
+    studies' checks by package (rsmhp.pipeline.config.studies), as the registry finds families."""
+    below = ("rsmhp.core", "rsmhp.models", "rsmhp.pipeline", "rsmhp.report")
+    bad = sorted(
+        f"{m} -> {i}"
+        for m, imports in GRAPH.items()
+        if m.startswith(below)
+        for i in imports
+        if _study(i)
+    )
+    assert not bad, bad
+
+
+def test_every_study_with_cross_field_checks_owns_them():
+    """A study's config checks live in its package (``checks.config_problems``); the
+    pipeline's config module names no study section in its messages, only the shared ones
+    (``uav``, the UAV model every UAV study builds on, and ``uav_models``) and the keys that
+    moved."""
+    from rsmhp.pipeline.config import studies
+
+    found = studies()
+    assert set(found) == set(STUDIES) - {"scenarios"}, found  # scenarios: the schema suffices
+    tree = ast.parse((SRC / "rsmhp/pipeline/config.py").read_text(encoding="utf-8"))
+    named = sorted(
+        {
+            f"{s}: {node.value[:60]!r}"
+            for node in ast.walk(tree)
+            if isinstance(node, ast.Constant) and isinstance(node.value, str)
+            for s in STUDIES
+            if s != "uav" and f"{s}." in node.value and "moved" not in node.value
+        }
+    )
+    assert not named, named
+    resources = (SRC / "rsmhp/pipeline/resources.py").read_text(encoding="utf-8")
+    assert "rsmhp.studies" not in "".join(i for i in GRAPH["rsmhp.pipeline.resources"])
+    assert "working_sets" in resources
+
+
+def _users(module: str) -> tuple[set[str], set[str]]:
+    """(studies, other modules outside ``module``) that import ``module`` or a name in it."""
+    studies, others = set(), set()
+    for m, imports in GRAPH.items():
+        if module in imports or any(
+            i.rpartition(".")[0] == module and i not in GRAPH for i in imports
+        ):
+            if s := _study(m):
+                studies.add(s)
+            elif not m.startswith(module):
+                others.add(m)
+    return studies, others
+
+
+#: model modules that the method registry imports by name (every study reaches them through it)
+_REGISTERED = "rsmhp.models.uav.methods."
+
+
+def _model_modules() -> list[str]:
+    return [
+        m
+        for m in GRAPH
+        if m.startswith("rsmhp.models.")
+        and not (SRC / (m.replace(".", "/") + "/__init__.py")).is_file()  # not a package
+        and not m.startswith(_REGISTERED)
+    ]
+
+
+@pytest.mark.parametrize("module", _model_modules())
+def test_a_model_module_lives_where_its_users_are(module):
+    """A model module that one study alone uses belongs in that study; one that several
+    studies use stays below them, and its docstring names each of them."""
+    studies, others = _users(module)
+    if len(studies) == 1 and not others:
+        pytest.fail(f"{module} is used by the {studies.pop()} study alone: move it into that study")
+    if len(studies) >= 2:
+        doc = (
+            ast.get_docstring(ast.parse((SRC / (module.replace(".", "/") + ".py")).read_text()))
+            or ""
+        )
+        missing = sorted(s for s in studies if f"rsmhp.studies.{s}" not in doc)
+        assert not missing, f"{module}'s docstring does not name its users {missing}"
+
+
+# ------------------------------------------------------------------ rule files share explicitly
+
+RULES = ROOT / "workflow/rules"
+_ASSIGNED = re.compile(r"^([A-Z][A-Z0-9_]*)\s*=", re.M)
+_USED = re.compile(r"\b([A-Z][A-Z0-9_]{2,})\b")
+
+
+def _globals(path: Path) -> set[str]:
+    return set(_ASSIGNED.findall(path.read_text(encoding="utf-8")))
+
+
+def _strip_strings(text: str) -> str:
+    """The text without comments and docstring lines (names there are prose, not reads)."""
+    lines = [line.split("#", 1)[0] for line in text.splitlines()]
+    return "\n".join(line for line in lines if not line.strip().startswith(('"""', "'")))
+
+
+def test_a_rule_file_reads_only_its_own_and_the_shared_globals():
+    """What several rule files need is defined once in common.smk (included first); no rule
+    file reads a global that another study's rule file defines, so the include order of the
+    study files does not matter."""
+    files = sorted(RULES.glob("*.smk"))
+    defined = {f.name: _globals(f) for f in files}
+    shared = defined["common.smk"]
+    owner = {n: f for f, names in defined.items() if f != "common.smk" for n in names}
+    bad = sorted(
+        f"{f.name} reads {n} of {owner[n]}"
+        for f in files
+        if f.name != "common.smk"
+        for n in set(_USED.findall(_strip_strings(f.read_text(encoding="utf-8"))))
+        if n in owner and owner[n] != f.name and n not in shared
+    )
+    assert not bad, bad
+    clash = sorted(n for n, f in owner.items() if n in shared)
+    assert not clash, f"defined both in common.smk and a study's rule file: {clash}"
+    snakefile = (ROOT / "Snakefile").read_text(encoding="utf-8")
+    includes = re.findall(r'include: "workflow/rules/(\w+)\.smk"', snakefile)
+    assert includes[0] == "common", includes
+
+
+def test_no_rule_file_reads_a_file_when_parsed():
+    """A rule file reads published files (paper/) as a rule's input, never when the workflow
+    is parsed (no open, json.load or read_text). The one exception is a package function:
+    make compare's pre-flight check of the published reference
+    (rsmhp.studies.frontier.reference.compare_problems), which refuses a comparison that would
+    not pair before any job."""
+    bad = sorted(
+        f"{f.name}: {pat}"
+        for f in RULES.glob("*.smk")
+        for pat in ("open(", "json.load", "read_text(", "load_reference(", "yaml.safe_load")
+        if pat in _strip_strings(f.read_text(encoding="utf-8"))
+    )
+    assert not bad, bad
+
+
+def test_the_rule_file_check_can_fail(tmp_path):
+    """The parser sees a planted cross-file read."""
+    a = tmp_path / "a.smk"
+    a.write_text("FOO_JOBS = [1]\n")
+    b = tmp_path / "b.smk"
+    b.write_text('rule x:\n    input: expand("{j}", j=FOO_JOBS)\n')
+    assert "FOO_JOBS" in _globals(a) and "FOO_JOBS" in _USED.findall(_strip_strings(b.read_text()))

@@ -35,7 +35,7 @@ LINE = re.compile(r"run store: (\d+) computed, (\d+) reused, (\d+) waited \(resu
 def requested(cfg: dict) -> dict[str, list[str]]:
     """Per rule, the key digest of every closed-loop run it asks for."""
     seed, uav = cfg["seed"], cfg["uav"]
-    models = cfg["decisions"]["uav"]["models"]
+    models = cfg["uav_models"]
     out: dict[str, list[str]] = {r: [] for r in RULES}
 
     def add(rule, setup, method, s, r):

@@ -539,7 +539,7 @@ def test_frontier_recording_replays_the_run_its_rule_chooses(run_j2, tiny):
 def test_uav_decision_outputs(run_j2, tiny):
     cfg = tiny["decisions"]
     regret = pd.read_csv(run_j2 / "results/decisions/uav_regret.csv")
-    n_states = cfg["uav"]["runs"] * len(cfg["uav"]["steps"]) * len(cfg["uav"]["models"])
+    n_states = cfg["uav"]["runs"] * len(cfg["uav"]["steps"]) * len(tiny["uav_models"])
     n_methods = 1 + len(cfg["uav"]["methods"]["rsmhp_nt"]) + len(cfg["uav"]["methods"]["tree"])
     assert len(regret) == n_states * n_methods
     assert (regret["regret"] >= -1e-9 * regret["best_cost"]).all()

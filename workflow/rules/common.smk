@@ -2,6 +2,9 @@
 from rsmhp.models.uav import methods as _registry
 from rsmhp.pipeline.code_digest import code_digest as _code_digest
 from rsmhp.pipeline.code_digest import method_only
+from rsmhp.pipeline.protocol import confirm_plan as _confirm_plan
+from rsmhp.models.uav.scoring import map_cells as _map_cells
+from rsmhp.models.uav.simulation import MODEL_KEYS as _UAV_MODEL_KEYS
 
 THREADS = config["threads"]
 
@@ -128,3 +131,37 @@ def table_outputs(names, category):
         )
         for n in names
     ]
+
+
+# ---------------------------------------------------------------------------------------
+# What several rule files read. A rule file reads the names defined here and its own, never
+# another rule file's (tests/pipeline/test_layout.py checks it), so the include order of the
+# study files does not matter; this file comes first.
+#
+# the keys of the uav section every UAV simulation depends on (besides its method and seed)
+UAV_MODEL_KEYS = _UAV_MODEL_KEYS
+# the UAV model variants (config uav_models): the decision study runs every one, the other
+# UAV studies the ones they name
+UAV_MODELS = canonical(config["uav_models"])
+# the scoring settings of the open-loop regret (decisions.uav), shared by the decision
+# study's map cells, the equal-compute and the long-horizon studies
+UAV_SCORING = pick(
+    config["decisions"]["uav"],
+    "n_eval",
+    "polish",
+    "random_starts",
+    "eval_maxiter",
+    "n_random",
+)
+# the confirmatory design: what the committed preregistration and tuned file name (checked
+# here, before any job: a tuned file that is not the preregistered one stops the workflow)
+CONFIRM = _confirm_plan(workflow.basedir, config["frontier"])
+CONFIRM_MODELS = list(CONFIRM["models"]) if CONFIRM is not None else []
+# the sensitivity map's cells (decisions.map): one job each, wildcard {cell} = r<i>c<j>
+MAP_CELLS = [c.name for c in _map_cells(config["decisions"]["map"])]
+# the long-horizon study's (model, H) jobs (horizon.uav)
+HZ_JOBS = [
+    f"{m}_H{h}"
+    for m in config["horizon"]["uav"]["models"]
+    for h in config["horizon"]["uav"]["H"]
+]

@@ -1,20 +1,17 @@
 # Decision-quality study: the regret of the controls each method chooses.
 # Simulation, aggregation and figures are separate rules; the sensitivity map runs one job
 # per cell (wildcard {cell} = r<i>c<j>), so a cell reruns alone and cells fan out.
-from rsmhp.studies.decisions.section_lqg import FIGURES as LQG_FIGURES
-from rsmhp.studies.decisions.section_uav import FIGURES as UAV_FIGURES
-from rsmhp.models.uav.scoring import map_cells
+from rsmhp.studies.decisions.section_lqg import FIGURES as DEC_LQG_FIGURES
+from rsmhp.studies.decisions.section_uav import FIGURES as DEC_UAV_FIGURES
 from rsmhp.studies.decisions.chunks import chunk_jobs, model_runs
 
 DEC = config["decisions"]
 DEC_UAV_FAMILIES = families_of(DEC["uav"]["methods"], "decisions.uav.methods")
 DEC_MAP_FAMILIES = families_of(DEC["map"]["methods"], "decisions.map.methods")
-MAP_CELLS = [c.name for c in map_cells(DEC["map"])]
-# the scoring settings of the open-loop regret, shared by the map cells
-DEC_SCORING = pick(
-    DEC["uav"], "n_eval", "polish", "random_starts", "eval_maxiter", "n_random"
-)
-DEC_FIGURES = [*LQG_FIGURES, *UAV_FIGURES]
+# the open-loop study runs every UAV model variant (uav_models): its cfg param carries them
+# as `models`, which is where its code reads them
+DEC_UAV = {**DEC["uav"], "models": UAV_MODELS}
+DEC_FIGURES = [*DEC_LQG_FIGURES, *DEC_UAV_FIGURES]
 REPORT_SECTIONS["decisions_lqg"] = "results/report/decisions_lqg.json"
 REPORT_SECTIONS["decisions_uav"] = "results/report/decisions_uav.json"
 REPORT_FIGURES.extend(DEC_FIGURES)
@@ -79,7 +76,7 @@ rule decisions_lqg_summary:
 
 # The UAV open-loop study runs as split.decisions_uav jobs of runs per model variant
 # (rsmhp.studies.decisions.chunks), merged into results/decisions/uav_regret.csv.
-DEC_UAV_JOBS = chunk_jobs(DEC["uav"], SPLIT["decisions_uav"])
+DEC_UAV_JOBS = chunk_jobs(DEC_UAV, SPLIT["decisions_uav"])
 
 
 rule decisions_uav:
@@ -99,7 +96,7 @@ rule decisions_uav:
         runtime=30,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        cfg=canonical(DEC["uav"]),
+        cfg=canonical(DEC_UAV),
         # this chunk's runs (the streams are keyed on model, run and step, not on the chunk)
         runs=lambda w: model_runs(
             DEC["uav"]["runs"], SPLIT["decisions_uav"], int(w.chunk)
@@ -128,7 +125,7 @@ rule decisions_uav_merge:
         mem_mb=1000,
         runtime=5,
     params:
-        cfg=canonical(DEC["uav"]),
+        cfg=canonical(DEC_UAV),
         jobs=SPLIT["decisions_uav"],
         code=code_digest("workflow/scripts/decisions_uav_merge.py"),
     script:
@@ -163,7 +160,7 @@ rule decisions_map_cell:
             "regret_steps",
             "track_loss_error",
         ),
-        scoring=DEC_SCORING,
+        scoring=UAV_SCORING,
         seed=config["seed"],
         families=DEC_MAP_FAMILIES,
         code=code_digest("workflow/scripts/decisions_map_cell.py", DEC_MAP_FAMILIES),
@@ -198,7 +195,7 @@ rule decisions_uav_summary:
         mem_mb=2000,
         runtime=10,
     params:
-        cfg=canonical(DEC),
+        cfg=canonical({**DEC, "uav": DEC_UAV}),
         base_limited=config["uav"]["sensor"]["footprint_radius"] is not None,
         seed=config["seed"],
         code=code_digest("workflow/scripts/decisions_uav_summary.py"),
@@ -225,7 +222,7 @@ rule decisions_figures:
         mem_mb=2000,
         runtime=5,
     params:
-        cfg=canonical(DEC["uav"]),
+        cfg=canonical(DEC_UAV),
         code=code_digest("workflow/scripts/decisions_figures.py"),
     script:
         "../scripts/decisions_figures.py"

@@ -1,20 +1,17 @@
 # Equal-compute study of the planners (frontier): one job per model variant with
 # paired closed-loop runs and open-loop regret of every method and its planning time per step
 # (one thread: the time is the study's measure of compute), then aggregation and the figure.
-import json
-
 import numpy as np
 
 from rsmhp.studies.frontier.figures import CONFIRM_FIGURES
 from rsmhp.studies.frontier.figures import FIGURES as FRONTIER_FIGURES
 from rsmhp.studies.frontier.section import CONFIRM_TABLES
 from rsmhp.studies.frontier.section import TABLES as FRONTIER_TABLES
-from rsmhp.pipeline.protocol import Configuration, confirm_plan, tuned_configurations
+from rsmhp.pipeline.protocol import tuned_configurations
 from rsmhp.studies.frontier.chunks import confirm_chunks, confirm_runs
 from rsmhp.studies.frontier.reference import (
-    check_reference,
+    compare_problems,
     ladder_rows,
-    load_reference,
     method_sources,
     scenario_fingerprint,
 )
@@ -28,9 +25,7 @@ FRONTIER_RECORDING = f"results/recordings/frontier_{FRONTIER_REC['model']}_plann
 if FRONTIER_MODELS and FRONTIER["exploratory"]:
     REPORT_SECTIONS["frontier_exploratory"] = "results/report/frontier_exploratory.json"
     REPORT_FIGURES.extend(FRONTIER_FIGURES)
-# the confirmatory run: what the committed preregistration and tuned file name (checked here,
-# before any job: a tuned file that is not the preregistered one stops the workflow)
-CONFIRM = confirm_plan(workflow.basedir, FRONTIER)
+# the confirmatory run (CONFIRM, CONFIRM_MODELS: common.smk)
 if CONFIRM is not None:
     REPORT_SECTIONS["frontier"] = "results/report/frontier.json"
     REPORT_FIGURES.extend(CONFIRM_FIGURES)
@@ -58,7 +53,7 @@ rule frontier_explore:
         runtime=60,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         cfg=pick(
             FRONTIER,
             "runs",
@@ -67,7 +62,7 @@ rule frontier_explore:
             "regret_steps",
             "track_loss_error",
         ),
-        scoring=DEC_SCORING,
+        scoring=UAV_SCORING,
         seed=config["seed"],
         families=FRONTIER_FAMILIES,
         code=code_digest("workflow/scripts/frontier_explore.py", FRONTIER_FAMILIES),
@@ -96,7 +91,7 @@ rule frontier_explore_timing:
         runtime=30,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         cfg=pick(FRONTIER, "methods", "timing"),
         seed=config["seed"],
         families=FRONTIER_FAMILIES,
@@ -181,7 +176,7 @@ rule frontier_recording:
         runtime=10,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         cfg=canonical(FRONTIER),
         recording=canonical(FRONTIER_REC),
         seed=config["seed"],
@@ -223,7 +218,7 @@ rule frontier_tune:
         runtime=120,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         tuning=canonical(TUNING),
         track_loss_error=FRONTIER["track_loss_error"],
         seed=config["seed"],
@@ -253,7 +248,7 @@ rule frontier_tune_timing:
         runtime=30,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         tuning=canonical(TUNING),
         seed=config["seed"],
         families=FRONTIER_FAMILIES,
@@ -297,16 +292,6 @@ rule tune:
 
 # The confirmatory run (part of the default run): the preregistered configurations of every
 # model on the confirm stream, their interleaved timing, then claims FR-*, tables, figure.
-CONFIRM_MODELS = list(CONFIRM["models"]) if CONFIRM is not None else []
-with open(
-    os.path.join(workflow.basedir, "paper/exploratory/claims_76a0c01.json")
-) as _f:
-    EXPLORATORY_CLAIMS = json.load(_f)["claims"]
-# the first confirmatory run's FR claims (superseded by the second preregistration; kept)
-with open(
-    os.path.join(workflow.basedir, "paper/superseded/claims_confirm1.json")
-) as _f:
-    SUPERSEDED = json.load(_f)
 
 
 # The confirmatory runs of a model run as split.frontier_confirm jobs of contiguous runs
@@ -328,7 +313,7 @@ rule frontier_confirm:
         runtime=30,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         plan=lambda w: CONFIRM["plans"][w.model],
         # this chunk's runs (the streams are keyed on the run, not on the chunk)
         runs=lambda w: confirm_runs(
@@ -391,7 +376,7 @@ rule frontier_confirm_timing:
         runtime=30,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         plan=lambda w: CONFIRM["plans"][w.model],
         stream=CONFIRM["stream"] if CONFIRM is not None else None,
         timing=canonical(FRONTIER["confirm"]["timing"]),
@@ -411,6 +396,10 @@ rule frontier_confirm_summary:
         timing=expand(
             "results/frontier/confirm/timing/{model}.csv", model=CONFIRM_MODELS
         ),
+        # the FR and HZ claims published at 76a0c01 (exploratory; kept, not counted), and
+        # the first confirmatory run's FR claims (superseded by the second preregistration)
+        exploratory="paper/exploratory/claims_76a0c01.json",
+        superseded="paper/superseded/claims_confirm1.json",
     output:
         summary="results/frontier/confirm_summary.csv",
         ladder="results/frontier/confirm_ladder.csv",
@@ -427,9 +416,6 @@ rule frontier_confirm_summary:
     params:
         confirm=CONFIRM,
         timing=canonical(FRONTIER["confirm"]["timing"]),
-        # the FR and HZ claims published at 76a0c01 (exploratory; kept, not counted)
-        exploratory=EXPLORATORY_CLAIMS,
-        superseded=SUPERSEDED,
         code=code_digest("workflow/scripts/frontier_confirm_summary.py"),
     script:
         "../scripts/frontier_confirm_summary.py"
@@ -484,7 +470,7 @@ if CONFIRM is not None:
         code_digest("workflow/scripts/frontier_confirm.py", []),
         {
             "uav": pick(config["uav"], *UAV_MODEL_KEYS),
-            "models": canonical(config["decisions"]["uav"]["models"]),
+            "models": UAV_MODELS,
             "runs": CONFIRM["runs"],
             "stream": CONFIRM["stream"],
             "seed": config["seed"],
@@ -514,19 +500,13 @@ if COMPARE_METHODS:
             "plugin_methods: the comparison needs the confirmatory design "
             "(frontier.models and the preregistration), and this config has none"
         )
-    try:
-        _, REFERENCE_META = load_reference(REFERENCE_DIR)
-        for _m in COMPARE_METHODS:
-            Configuration(_m)  # refuses a name no registered family parses
-    except ValueError as exc:
-        sys.exit(f"plugin_methods: {exc}")
-    _problems = check_reference(REFERENCE_META, SCENARIO, CONFIRM_MODELS)
-    if _problems:
-        sys.exit(
-            f"plugin_methods: the published reference ({REFERENCE_DIR}) ran other scenarios "
-            "than this workflow, so its runs would not pair with the new method's; refused. "
-            "What differs:\n  - " + "\n  - ".join(_problems)
-        )
+    # the one file a rule file reads when parsed: the published reference, so that a
+    # comparison that would not pair is refused before any job (docs/compare.md)
+    _refused = compare_problems(
+        REFERENCE_DIR, SCENARIO, CONFIRM_MODELS, COMPARE_METHODS
+    )
+    if _refused:
+        sys.exit(_refused)
 
 
 rule frontier_reference:
@@ -578,7 +558,7 @@ rule frontier_compare_run:
         runtime=60,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         methods=COMPARE_METHODS,
         runs=lambda w: CONFIRM["runs"][w.model],
         stream=CONFIRM["stream"] if CONFIRM is not None else None,

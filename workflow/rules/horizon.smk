@@ -18,7 +18,6 @@ HZ_FAMILIES = families_of(HZ["methods"], "horizon.uav.methods")
 HZL = config["horizon"]["lqg"]
 HZL_MODEL = pick(config["lqg"]["model"], "x0", "r", "target", "sigma")
 HZ_MODELS = list(HZ["models"])
-HZ_JOBS = [f"{m}_H{h}" for m in HZ_MODELS for h in HZ["H"]]
 HZ_REC = HZ.get("recording", {}) or {}
 HZ_RECORDING = (
     [f"results/recordings/hz_{HZ_REC['model']}_H{HZ_REC['H']}.rrd"]
@@ -37,8 +36,8 @@ HZO_MODELS = list(HZ_MODELS if HZO.get("models") is None else HZO["models"])
 HZO_JOBS = [f"{m}_H{h}" for m in HZO_MODELS for h in HZO["H"]]
 # what one job of the split depends on besides the model, H and the planner
 HZO_KEYS = ("runs", "steps", "methods", "budgets", "polish_starts", "polish_maxiter")
-# each model variant's decisions.uav.models entry (its overrides), for the job of that model
-HZ_VARIANTS = {m["name"]: canonical(m) for m in config["decisions"]["uav"]["models"]}
+# each model variant's uav_models entry (its overrides), for the job of that model
+HZ_VARIANTS = {m["name"]: m for m in UAV_MODELS}
 HZO_SUMMARY = ["results/horizon/optimiser_summary.csv"] if HZO_MODELS else []
 if HZO_MODELS:
     REPORT_SECTIONS["horizon_optimiser"] = "results/report/horizon_optimiser.json"
@@ -83,9 +82,9 @@ rule horizon_uav:
         runtime=60,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         cfg=pick(HZ, "runs", "steps", "plans", "n_ref", "replicates", "methods"),
-        scoring=DEC_SCORING,
+        scoring=UAV_SCORING,
         # this chunk's runs (the streams are keyed on the run, not on the chunk)
         runs=lambda w: layout_runs(
             HZ_UNITS["horizon_uav"], HZ["runs"], w.hmodel, w.H, int(w.chunk)
@@ -146,7 +145,7 @@ rule horizon_uav_closed:
         runtime=60,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         cfg=pick(HZ, "closed_runs", "methods"),
         # this chunk's closed-loop runs (keyed on the run, not on the chunk)
         runs=lambda w: layout_runs(
@@ -323,7 +322,7 @@ rule horizon_recording:
         runtime=15,
     params:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
-        models=canonical(config["decisions"]["uav"]["models"]),
+        models=UAV_MODELS,
         cfg=pick(HZ, "closed_runs", "methods", "claims"),
         recording=canonical(HZ_REC),
         seed=HZ_SEED,
@@ -352,7 +351,7 @@ rule horizon_optimiser:
         uav=pick(config["uav"], *UAV_MODEL_KEYS),
         model=lambda wc: HZ_VARIANTS[wc.hmodel],
         cfg=pick(HZO, *HZO_KEYS),
-        scoring=pick(DEC["uav"], "n_eval", "polish", "random_starts"),
+        scoring=pick(UAV_SCORING, "n_eval", "polish", "random_starts"),
         # this chunk's runs (the streams are keyed on the run, not on the chunk)
         runs=lambda w: layout_runs(
             HZ_UNITS["horizon_optimiser"], HZO["runs"], w.hmodel, w.H, int(w.chunk)

@@ -68,7 +68,7 @@ rule scenarios_summary:
         mem_mb=1000,
         runtime=5,
     params:
-        n_boot=2000,
+        n_boot=config["scenarios"]["bootstrap"],
         seed=config["seed"],
         code=code_digest("workflow/scripts/scenarios_summary.py"),
     script:

@@ -5,7 +5,7 @@
 # and recordings as separate rules.
 import re
 
-from rsmhp.studies.uav.simulate import UAV_MODEL_KEYS, chunk_runs
+from rsmhp.studies.uav.simulate import chunk_runs
 from rsmhp.models.uav import methods as uav_methods
 
 UAV = config["uav"]

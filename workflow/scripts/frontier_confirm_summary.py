@@ -1,6 +1,7 @@
 """Rule frontier_confirm_summary: the confirmatory run's statistics (per configuration and per
 budget rung), claims FR-*, tables and the report section."""
 
+import json
 from pathlib import Path
 
 import pandas as pd
@@ -41,7 +42,9 @@ with rule_logging(snakemake) as log:
     lad = ladder(runs, summary, chosen, pre["budgets_ms"])
     claims = confirm_claims(runs, summary, lad, pre, chosen, c["sha256"])
     tables = confirm_tables(summary, lad, c["tuned"])
-    exploratory = snakemake.params.exploratory
+    exploratory = json.loads(Path(snakemake.input.exploratory).read_text(encoding="utf-8"))
+    exploratory = exploratory["claims"]
+    superseded = json.loads(Path(snakemake.input.superseded).read_text(encoding="utf-8"))
     commit = file_commit(Path(snakemake.scriptdir).resolve().parents[1] / c["path"])
     meta = {"path": c["path"], "sha256": c["sha256"], "commit": commit}
     section = confirm_section(
@@ -54,7 +57,7 @@ with rule_logging(snakemake) as log:
             prereg_meta=meta,
             tuned=c["tuned"],
             exploratory=exploratory,
-            superseded=snakemake.params.superseded,
+            superseded=superseded,
         )
     )
     write_csv(summary, snakemake.output.summary)

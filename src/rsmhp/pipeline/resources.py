@@ -14,9 +14,11 @@ A rule with ``w`` workers then needs ``BASE_MB + w (WORKER_MB + W / 2^20)`` MB, 
 ``BASE_MB`` is the interpreter with numpy, scipy and pandas loaded and ``WORKER_MB`` one joblib
 worker process (measured resident sizes, rounded up).
 
-:func:`memory_problems` compares these estimates with the rules' declared ``mem_mb`` and names
-the config keys that drive each estimate. The UAV rules are not estimated: their arrays grow
-with the hypothesis counts (at most 10^6 by the schema, a few tens of MB).
+Each study estimates its own rules (``working_sets`` in its ``checks`` module, with this
+module's :func:`working_set_bytes`); :func:`memory_problems` compares these estimates with
+the rules' declared ``mem_mb`` and names the config keys that drive each estimate. The UAV
+rules are not estimated: their arrays grow with the hypothesis counts (at most 10^6 by the
+schema, a few tens of MB).
 """
 
 from __future__ import annotations
@@ -24,7 +26,14 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-__all__ = ["BASE_MB", "WORKER_MB", "estimate_mb", "memory_problems", "working_set_bytes"]
+__all__ = [
+    "BASE_MB",
+    "WORKER_MB",
+    "estimate_mb",
+    "memory_problems",
+    "working_set_bytes",
+    "working_sets",
+]
 
 BASE_MB = 300
 FIXED_BYTES = 1 << 24
@@ -43,52 +52,17 @@ def _rule_mb(work: int, workers: int) -> int:
     return int(BASE_MB + workers * (extra + work / 2**20))
 
 
-def _lqg_cells(config: Mapping[str, Any]) -> dict[str, tuple[int, str]]:
-    """Largest working set (bytes) of each LQG-type rule and the keys that drive it."""
-    from rsmhp.models.lqg import ablation as estimators
-    from rsmhp.models.lqg import regret as decisions_lqg
-    from rsmhp.studies.lqg import simulate as lqg
+def working_sets(config: Mapping[str, Any]) -> dict[str, tuple[int, str]]:
+    """Largest working set (bytes) of each estimated rule and the config keys that drive it:
+    every study's own estimates (``rsmhp.studies.<study>.checks.working_sets``, where its
+    ``checks`` module has one; :func:`rsmhp.pipeline.config.studies`)."""
+    from rsmhp.pipeline.config import studies, study_checks
 
     out: dict[str, tuple[int, str]] = {}
-    conv = config["lqg"]["convergence"]
-    out["lqg_convergence"] = (
-        working_set_bytes(max(lqg.p_grid(conv["P"])), len(conv["u"])),
-        "lqg.convergence.P.stop, lqg.convergence.u (its length H), threads",
-    )
-    ne = config["lqg"]["nbo_error"]
-    out["lqg_nbo_error"] = (
-        working_set_bytes(ne["P"], max(ne["H_values"])),
-        "lqg.nbo_error.P, lqg.nbo_error.H_values, threads",
-    )
-    dec = config.get("decisions", {}).get("lqg")
-    if dec:
-        cells = decisions_lqg.regret_cells(dec)
-        out["decisions_lqg"] = (
-            max((working_set_bytes(c.P, c.H) for c in cells), default=0),
-            "decisions.lqg.P, decisions.lqg.tree_N / max_leaves, decisions.lqg.H_values, threads",
-        )
-    est = config["estimators"]
-    specs = {s["name"]: {k: v for k, v in s.items() if k != "name"} for s in est["problems"]}
-    problems = {n: estimators.build_problem(s, config["lqg"]["model"]) for n, s in specs.items()}
-    reps = int(est["replicates"])
-    biggest = 0
-    for pt in estimators.grid_points(est, problems):
-        prob = problems[pt.problem]
-        leaves = estimators.n_trajectories(pt, prob)
-        if pt.scheme in ("tree", "tree_pernode"):
-            # replicate trees of row-wise problems are sampled in batches of <= 2^20 leaves
-            batch = estimators.BATCH_LEAVES
-            per = min(reps, max(1, batch // leaves)) if prob.noise.rowwise else 1
-            P = per * leaves
-        elif pt.scheme == "pruned":
-            P = pt.M * pt.N  # every kept node's N children exist before pruning
-        else:
-            P = leaves
-        biggest = max(biggest, working_set_bytes(P, prob.H, prob.d))
-    out["estimators_ablation"] = (
-        biggest,
-        "estimators.budgets, estimators.max_leaves, estimators.tree_N, estimators.pruning, threads",
-    )
+    for name in studies():
+        estimate = getattr(study_checks(name), "working_sets", None)
+        if estimate is not None:
+            out.update(estimate(config))
     return out
 
 
@@ -96,7 +70,7 @@ def estimate_mb(config: Mapping[str, Any]) -> dict[str, tuple[int, str]]:
     """Estimated peak memory (MB) of each estimated rule with ``config["threads"]`` workers,
     and the config keys that drive it."""
     threads = int(config.get("threads", 1))
-    return {rule: (_rule_mb(w, threads), keys) for rule, (w, keys) in _lqg_cells(config).items()}
+    return {rule: (_rule_mb(w, threads), keys) for rule, (w, keys) in working_sets(config).items()}
 
 
 def memory_problems(config: Mapping[str, Any], declared_mb: Mapping[str, Any]) -> list[str]:

@@ -92,8 +92,11 @@ def provenance(
     }
     if config is not None:
         # every parameter that can change a number; `threads` cannot (results are identical
-        # for any worker count), so it is left out and shown on its own
-        numbers = {k: v for k, v in config.items() if k != "threads"}
+        # for any worker count), so it is left out and shown on its own; a change of the
+        # config's layout alone changes no number (rsmhp.pipeline.config_layout.hash_view)
+        from rsmhp.pipeline.config_layout import hash_view
+
+        numbers = {k: v for k, v in hash_view(config).items() if k != "threads"}
         canon = json.dumps(numbers, sort_keys=True, default=str).encode()
         out["config sha256"] = hashlib.sha256(canon).hexdigest()[:16]
         out["threads"] = f"{config.get('threads', '?')} (of {os.cpu_count()} CPUs)"

@@ -88,7 +88,7 @@ def test_a_methods_open_loop_numbers_do_not_depend_on_the_others(footprint):
 
 
 def test_unknown_model_is_refused():
-    with pytest.raises(ValueError, match=r"'nowhere' is not a model of decisions\.uav\.models"):
+    with pytest.raises(ValueError, match=r"'nowhere' is not a model of uav_models"):
         run_frontier_model(_uav(), MODELS, FRONTIER, SCORING, "nowhere", 5)
 
 
@@ -177,7 +177,7 @@ def test_bad_frontier_config_is_refused_naming_the_fields():
     with pytest.raises(ConfigError) as err:
         check_config(cfg)
     msg = str(err.value)
-    assert "frontier.models: ['nowhere'] not model(s) of decisions.uav.models" in msg
+    assert "frontier.models: ['nowhere'] not model(s) of uav_models" in msg
     assert "frontier.methods.nbo: false (allowed: true" in msg
     assert "frontier.methods.rqmc_nt[1]: 48 is not a power of 2" in msg
     assert "frontier.regret_steps: [60] not before the run's last step" in msg

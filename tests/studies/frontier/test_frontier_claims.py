@@ -320,13 +320,12 @@ def test_replay_check_refuses_a_stale_table():
 def test_recording_setup_shows_nbo_and_every_budget_member():
     from rsmhp.studies.frontier.simulate import recording_setup
 
-    dec = CONFIG["decisions"]
     fr = CONFIG["frontier"]
-    setup, methods = recording_setup(CONFIG["uav"], dec["uav"]["models"], fr, "footprint150")
+    setup, methods = recording_setup(CONFIG["uav"], CONFIG["uav_models"], fr, "footprint150")
     assert [m.name for m in methods] == ["nbo", *fr["budget"]["members"]]
     assert setup.sensor.limited
     with pytest.raises(ValueError, match=re.escape("frontier.recording.model: 'nowhere'")):
-        recording_setup(CONFIG["uav"], dec["uav"]["models"], fr, "nowhere")
+        recording_setup(CONFIG["uav"], CONFIG["uav_models"], fr, "nowhere")
 
 
 # ------------------------------------------------------- ledger fields: n, margin, check

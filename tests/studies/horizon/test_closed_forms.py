@@ -1,6 +1,6 @@
-"""Long-horizon closed forms of the oven LQG (rsmhp.models.lqg.horizon) against independent oracles:
-the open-loop optimum of rsmhp.models.lqg.oven, a least-squares solution of the stage-cost
-regulator, the algebraic Riccati equation and the finite sums."""
+"""Long-horizon closed forms of the oven LQG (rsmhp.studies.horizon.closed_forms) against
+independent oracles: the open-loop optimum of rsmhp.models.lqg.oven, a least-squares solution
+of the stage-cost regulator, the algebraic Riccati equation and the finite sums."""
 
 from __future__ import annotations
 
@@ -9,8 +9,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rsmhp.models.lqg import horizon as lh
 from rsmhp.models.lqg import oven as lqg
+from rsmhp.studies.horizon import closed_forms as lh
 
 A_VALUES = st.floats(0.05, 0.95)
 R_VALUES = st.floats(0.1, 50.0)

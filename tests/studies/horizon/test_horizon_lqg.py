@@ -22,10 +22,10 @@ import yaml
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from rsmhp.models.lqg import horizon as lh
 from rsmhp.models.lqg import oven as lqg
 from rsmhp.models.lqg.regret_summary import bonferroni
 from rsmhp.pipeline.contracts import check_table
+from rsmhp.studies.horizon import closed_forms as lh
 from rsmhp.studies.horizon import simulate_lqg as E
 from rsmhp.studies.horizon import summarise_lqg as A
 from rsmhp.studies.horizon.claims import HZ5_RULE, hz4_rule, lqg_horizon_claims

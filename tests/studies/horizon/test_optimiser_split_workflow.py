@@ -279,7 +279,7 @@ def test_bad_optimiser_config_is_refused_naming_the_field(edit, expected):
         ),
         (
             lambda o: o.update(models=["paper", "nosuch"]),
-            "horizon.optimiser.models: ['nosuch'] not model(s) of decisions.uav.models",
+            "horizon.optimiser.models: ['nosuch'] not model(s) of uav_models",
         ),
         (
             lambda o: o.update(budgets=[{"maxiter": 30}, {"maxiter": 30, "maxfun": 5}]),

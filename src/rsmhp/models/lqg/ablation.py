@@ -26,6 +26,9 @@ only column that is not reproducible bit for bit. Deterministic schemes have one
 Trees of the scalar problems (one-dimensional noise) are sampled for many replicates at once
 (:func:`rsmhp.core.sampling.sample_tree_batch`, bit-identical estimates); their ``cpu_seconds`` is
 the batch's sampling time divided by its replicates, plus the replicate's own estimate time.
+
+Shared by the studies ``rsmhp.studies.estimators`` and ``rsmhp.studies.horizon`` (so it lives
+below them).
 """
 
 from __future__ import annotations

@@ -38,6 +38,9 @@ Linear dynamics, linear cost (paper Prop. 3)
 cost is Gaussian, with the paper's variance :math:`C[\sum_k \mathcal A_k \Sigma
 \mathcal A_k^\top]C^\top` (:meth:`LinearCost.prop3_variance`) and a :class:`QuadraticForm`
 with :math:`K = 0` (:attr:`LinearCost.quadratic_form`).
+
+Shared by the studies ``rsmhp.studies.estimators``, ``rsmhp.studies.horizon`` and
+``rsmhp.studies.lqg`` (so it lives below them).
 """
 
 from __future__ import annotations

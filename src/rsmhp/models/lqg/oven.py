@@ -61,6 +61,9 @@ the simulated system and gives the keyword arguments of the closed forms
 (:meth:`LQGModel.closed_form_args`).
 :meth:`rsmhp.models.lqg.linear_quadratic.LinearQuadratic.from_lqg`
 writes it in the general linear-quadratic form.
+
+Shared by the studies ``rsmhp.studies.decisions``, ``rsmhp.studies.horizon`` and
+``rsmhp.studies.lqg`` (so it lives below them).
 """
 
 from __future__ import annotations

@@ -38,6 +38,9 @@ weighting and the argmins and regrets of all replicates follow in closed form at
 full shared-draw tree's :math:`\bar e` separates by level (no enumeration of its N^H
 leaves); the pruned tree runs in compiled code (:func:`_pruned_leaves`, tested against
 :func:`rsmhp.core.sampling.sample_tree`).
+
+Shared by the studies ``rsmhp.studies.decisions`` and ``rsmhp.studies.horizon`` (so it lives
+below them).
 """
 
 from __future__ import annotations

@@ -24,6 +24,9 @@ final state.
 Slopes: OLS fit :math:`\log \bar\rho = c + s \log x` per (a, H, method, weighting) with
 :math:`x = P` (tree: N; pruned: M = P) and a t-interval for :math:`s`
 (:func:`rsmhp.core.stats.loglog_slope`).
+
+Shared by the studies ``rsmhp.studies.decisions`` and ``rsmhp.studies.horizon`` (so it lives
+below them).
 """
 
 from __future__ import annotations

@@ -28,6 +28,9 @@ differences). Both optimisers work on the box, with at most ``maxiter`` iteratio
 ``maxfun`` evaluations (identical for every method), scipy's default tolerances, started from
 the warm start (the previous plan shifted by one step, last control repeated; zeros at the
 first step).
+
+Shared by the studies ``rsmhp.studies.frontier`` and ``rsmhp.studies.horizon`` (so it lives
+below them).
 """
 
 from __future__ import annotations

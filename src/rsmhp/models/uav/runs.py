@@ -34,6 +34,9 @@ protocol's times come from the interleaved timing rules).
 Families defined outside ``rsmhp.models.uav.methods`` (a plugin package, a test) are never
 stored: their code is not under the digest. Runs with an ``observer`` (recordings) are not
 stored either; they call :func:`~rsmhp.models.uav.simulation.simulate_run` themselves.
+
+Shared by the studies ``rsmhp.studies.frontier``, ``rsmhp.studies.horizon`` and
+``rsmhp.studies.uav`` (so it lives below them).
 """
 
 from __future__ import annotations

@@ -35,6 +35,9 @@ Rank agreement: ``n_random`` plans uniform in the box (and ``n_random`` local pe
 of the best plan, :math:`x_{best} + \mathcal N(0, 0.1^2)` clipped to the box) are costed by
 every method's own objective and by :math:`\hat J_{ev}`; Spearman's rank correlation
 between the two.
+
+Shared by the studies ``rsmhp.studies.decisions``, ``rsmhp.studies.frontier`` and
+``rsmhp.studies.horizon`` (so it lives below them).
 """
 
 from __future__ import annotations
@@ -476,11 +479,10 @@ def run_map_cell(
 
 
 def variant(models: list[Mapping[str, Any]], name: str) -> Mapping[str, Any]:
-    """The model variant called ``name`` of ``decisions.uav.models``."""
+    """The model variant called ``name`` of ``uav_models``."""
     found = {m["name"]: m for m in models}
     if name not in found:
         raise ValueError(
-            f"frontier.models: {name!r} is not a model of decisions.uav.models "
-            f"(allowed: {', '.join(found)})"
+            f"frontier.models: {name!r} is not a model of uav_models (allowed: {', '.join(found)})"
         )
     return found[name]

@@ -46,6 +46,9 @@ planning step in model steps (:attr:`rsmhp.models.uav.planner.PlanResult.work`: 
 steps, a gradient evaluation counting its forward and adjoint pass; generative-model calls of
 a tree search), ``converged_rate`` the fraction of plans whose optimiser stopped on a
 tolerance rather than on its iteration or evaluation budget (NaN for a planner without one).
+
+Shared by the studies ``rsmhp.studies.decisions``, ``rsmhp.studies.frontier``,
+``rsmhp.studies.horizon`` and ``rsmhp.studies.uav`` (so it lives below them).
 """
 
 from __future__ import annotations
@@ -71,6 +74,7 @@ from rsmhp.models.uav.stepper import Stepper
 from rsmhp.models.uav.target import TargetModel
 
 __all__ = [
+    "MODEL_KEYS",
     "STEP_VALUES",
     "Scenario",
     "StepInfo",
@@ -78,6 +82,12 @@ __all__ = [
     "draw_scenario",
     "simulate_run",
 ]
+
+
+#: the keys of the config's ``uav`` section that define the model a UAV simulation runs
+#: (:meth:`UAVSetup.from_config`); besides them a job depends on its method and the seed. Every
+#: UAV study's rules pass these keys as a param (``workflow/rules/common.smk``)
+MODEL_KEYS = ("dt", "g", "aircraft", "target", "sensor", "tracker", "scenario", "planner")
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """The UAV decision study split in jobs (config ``split.decisions_uav``).
 
-Rule ``decisions_uav`` runs one model variant of ``decisions.uav.models`` and a contiguous
+Rule ``decisions_uav`` runs one model variant of ``uav_models`` and a contiguous
 chunk of its runs (:func:`model_runs`): the belief states of those NBO runs and every method's
 plan at them, scored as :func:`rsmhp.models.uav.scoring.run_uav_regret` scores them
 (:func:`run_regret_chunk`; the streams are keyed on model, run, step and method, never on the

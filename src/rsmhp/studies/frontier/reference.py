@@ -37,6 +37,7 @@ __all__ = [
     "REFERENCE_COLUMNS",
     "RUNS_FILE",
     "check_reference",
+    "compare_problems",
     "config_sha256",
     "ladder_rows",
     "load_reference",
@@ -194,3 +195,32 @@ def check_reference(
         f"model {m!r}: not in the reference (it ran {sorted(ran)})" for m in models if m not in ran
     ]
     return problems
+
+
+def compare_problems(
+    directory: str | os.PathLike,
+    current: Mapping[str, Any],
+    models: Sequence[str],
+    methods: Sequence[str],
+) -> str:
+    """``make compare``'s pre-flight check, run when the workflow is parsed so that a
+    comparison that would not pair is refused before any job: the reference in
+    ``directory`` exists and is intact (:func:`load_reference`), every name of ``methods``
+    belongs to a registered family, and the reference ran this workflow's scenarios
+    (:func:`check_reference` against ``current``). The refusal message ('' when none)."""
+    from rsmhp.pipeline.protocol import Configuration
+
+    try:
+        _, meta = load_reference(directory)
+        for name in methods:
+            Configuration(name)  # refuses a name no registered family parses
+    except ValueError as exc:
+        return f"plugin_methods: {exc}"
+    problems = check_reference(meta, current, models)
+    if not problems:
+        return ""
+    return (
+        f"plugin_methods: the published reference ({directory}) ran other scenarios than this "
+        "workflow, so its runs would not pair with the new method's; refused. What differs:\n"
+        "  - " + "\n  - ".join(problems)
+    )

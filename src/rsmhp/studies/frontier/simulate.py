@@ -2,7 +2,7 @@ r"""Equal-compute study of the UAV planners (the ``frontier`` config section): e
 planner family at several sizes, on named model variants of the decision study, with the
 compute each one spends measured in the same job.
 
-Per model variant (``decisions.uav.models`` by name) one job computes
+Per model variant (``uav_models`` by name) one job computes
 
 * **closed loop**: runs ``0..runs-1`` of every method, paired (the same scenarios, target and
   sensor noise for every method: :mod:`rsmhp.models.uav.simulation`), with the planner's wall time
@@ -134,7 +134,7 @@ def run_frontier_model(
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The study for one model variant (see the module docstring): ``(closed-loop rows,
     FRONTIER_RUN_COLUMNS; open-loop rows, REGRET_COLUMNS with ``model`` = the variant's
-    name)``. ``uav`` is the (validated) ``uav`` section, ``models`` ``decisions.uav.models``,
+    name)``. ``uav`` is the (validated) ``uav`` section, ``models`` ``uav_models``,
     ``cfg`` the ``frontier`` section, ``scoring`` the ``decisions.uav`` section.
     Runs on one thread: the planning times are the study's measure of compute. With a
     ``store``, closed-loop runs it holds are read, not simulated (:mod:`rsmhp.models.uav.runs`),

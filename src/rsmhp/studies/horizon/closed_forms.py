@@ -1,5 +1,6 @@
 r"""The oven LQG at long horizons: limits as H grows and the horizon at which the optimal first
-control stops depending on H (closed forms; :mod:`rsmhp.models.lqg.oven` has the model).
+control stops depending on H (closed forms; :mod:`rsmhp.models.lqg.oven` has the model). The
+long-horizon study's own (no other study uses it; until version 5 ``rsmhp.models.lqg.horizon``).
 
 With :math:`b = 1-a` and :math:`S_H = \sum_{n=0}^{H-1} b^{2n} = (1-b^{2H})/(1-b^2)`:
 

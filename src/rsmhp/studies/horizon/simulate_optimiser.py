@@ -106,7 +106,6 @@ __all__ = [
     "RULE",
     "SPLIT_COLUMNS",
     "budgets",
-    "config_problems",
     "run_optimiser_split",
     "split_contract",
     "split_methods",
@@ -163,61 +162,6 @@ def budgets(cfg: Mapping[str, Any]) -> list[tuple[int, int, int]]:
     if dup:
         raise ValueError(f"budgets: (maxiter, restarts) {dup} appear twice")
     return out
-
-
-def config_problems(config: Mapping[str, Any]) -> list[str]:
-    """Cross-field problems of ``horizon.optimiser`` in a whole (schema-valid) config, each
-    naming its field and what is allowed: models of ``decisions.uav.models``, belief-state
-    steps before the run's last step, the methods' own checks and at least one method with
-    an own cost (a tree search alone has nothing to optimise), budgets that differ in
-    (maxiter, restarts). Empty when the section is absent."""
-    hz = config.get("horizon", {}) or {}
-    cfg = hz.get("optimiser")
-    if not isinstance(cfg, Mapping):
-        return []
-    path = "horizon.optimiser"
-    uav = config.get("uav", {}) or {}
-    problems: list[str] = []
-    dec = (config.get("decisions", {}) or {}).get("uav", {}) or {}
-    names = [m.get("name") for m in dec.get("models", []) or [] if isinstance(m, Mapping)]
-    models = cfg.get("models")
-    if models is None:  # default: the horizon study's models
-        models = (hz.get("uav", {}) or {}).get("models", []) or []
-    unknown = [m for m in models if names and m not in names]
-    if unknown:
-        problems.append(
-            f"{path}.models: {unknown} not model(s) of decisions.uav.models "
-            f"(allowed: {', '.join(map(str, names))})"
-        )
-    n_steps = (uav.get("scenario", {}) or {}).get("steps", 60)
-    late = [s for s in cfg.get("steps", []) or [] if isinstance(s, int) and s >= n_steps]
-    if late:
-        problems.append(
-            f"{path}.steps: {late} not before the run's last step (allowed: 0 <= step < "
-            f"uav.scenario.steps = {n_steps})"
-        )
-    meth = cfg.get("methods")
-    if isinstance(meth, Mapping):
-        own = methods.config_problems(meth, f"{path}.methods", uav)
-        problems += own
-        if not own:
-            try:
-                found = split_methods(cfg)
-            except (ValueError, TypeError) as exc:
-                problems.append(f"{path}.methods: {exc}")
-            else:
-                if not found:
-                    problems.append(
-                        f"{path}.methods: no method with an own cost (allowed: at least one "
-                        "of NBO, the sigma points or a sampled-cost member; a tree search "
-                        "has no cost of a given plan to optimise)"
-                    )
-    if isinstance(cfg.get("budgets"), Sequence) and cfg["budgets"]:
-        try:
-            budgets(cfg)
-        except (ValueError, TypeError) as exc:  # the messages start with "budgets"
-            problems.append(f"{path}.{exc} (allowed: budgets that differ in maxiter or restarts)")
-    return problems
 
 
 def split_methods(cfg: Mapping[str, Any]) -> dict[str, Method]:
@@ -384,7 +328,7 @@ def run_optimiser_split(
     runs: Sequence[int] | None = None,
 ) -> pd.DataFrame:
     """The split (module docstring) for one model variant (an entry of
-    ``decisions.uav.models``: ``name`` and overrides) at horizon ``H``: one row per (run,
+    ``uav_models``: ``name`` and overrides) at horizon ``H``: one row per (run,
     step, method with an own cost, budget), :data:`SPLIT_COLUMNS`. ``uav`` is the validated
     ``uav`` section; ``cfg`` has ``runs``, ``steps``, ``methods``, ``budgets``,
     ``polish_starts``, ``polish_maxiter``; ``scoring`` has ``n_eval``, ``polish`` and

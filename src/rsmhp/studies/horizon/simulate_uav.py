@@ -1,7 +1,7 @@
 r"""UAV horizon study (the ``horizon`` config section): how each planner's cost approximation,
 its decisions and its planning time change with the horizon H.
 
-Per model variant (``decisions.uav.models`` by name) and horizon H, one job works at the
+Per model variant (``uav_models`` by name) and horizon H, one job works at the
 belief states of closed-loop NBO runs ``0..runs-1`` at ``steps`` (the runs use the base
 horizon ``uav.planner.horizon``, so every H sees the same belief states) and computes:
 
@@ -256,7 +256,7 @@ def run_horizon(
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The study for (``model``, ``H``) (module docstring): ``(cost-approximation rows,
     APPROX_COLUMNS; regret rows, HORIZON_REGRET_COLUMNS)``. ``uav`` is the validated ``uav``
-    section, ``models`` ``decisions.uav.models``, ``cfg`` the ``horizon`` section,
+    section, ``models`` ``uav_models``, ``cfg`` the ``horizon`` section,
     ``scoring`` the decision study's scoring settings. Runs on one thread. ``runs``: the
     belief states of these runs only (default ``0..runs-1``; a chunk job's rows are the
     unsplit job's rows of its runs, :mod:`rsmhp.studies.horizon.chunks`)."""

@@ -11,8 +11,8 @@ and for uniform Monte Carlo its closed form :math:`\sqrt{\mathrm{Var}\,g / n}/J`
 
 Regret: the decision study's summary (:func:`rsmhp.models.lqg.regret_summary.summarize_lqg_regret`:
 mean regret with t-CI, closed form, z-score) with the long-horizon limit of each cell's closed
-form (``limit``: :func:`rsmhp.models.lqg.horizon.mc_regret_limit` for uniform Monte Carlo, 0 for the
-exact methods, NaN where the closed form has no limit or there is none).
+form (``limit``: :func:`rsmhp.studies.horizon.closed_forms.mc_regret_limit` for uniform Monte
+Carlo, 0 for the exact methods, NaN where the closed form has no limit or there is none).
 """
 
 from __future__ import annotations
@@ -24,9 +24,9 @@ import numpy as np
 import pandas as pd
 
 from rsmhp.core.seeding import job_rng
-from rsmhp.models.lqg import horizon as lqg_horizon
 from rsmhp.models.lqg.ablation import build_problem, summarize_ablation
 from rsmhp.models.lqg.regret_summary import ZERO_REGRET, summarize_lqg_regret
+from rsmhp.studies.horizon import closed_forms as lqg_horizon
 from rsmhp.studies.horizon.simulate_lqg import problem_name, problem_specs
 
 __all__ = [

@@ -42,8 +42,8 @@ from scipy import stats as sps
 
 from rsmhp.core.seeding import job_rng
 from rsmhp.core.stats import ClusterInterval, cluster_t_ci, runs_for_power
-from rsmhp.models.lqg import horizon as lqg_horizon
 from rsmhp.models.lqg import oven as lqg
+from rsmhp.studies.horizon import closed_forms as lqg_horizon
 
 __all__ = [
     "APPROX_SUMMARY_COLUMNS",
@@ -301,8 +301,8 @@ def summarize_horizon_regret(regret: pd.DataFrame) -> pd.DataFrame:
 
 
 def lqg_horizon_table(a_values, H_values, *, r: float, sigma: float, eps: float) -> pd.DataFrame:
-    """Closed forms of the oven LQG at long horizons (:mod:`rsmhp.models.lqg.horizon`), one row per
-    a: NBO's error limit :math:`r\\sigma^2/(1-(1-a)^2)` (``nbo_limit``) and its share
+    """Closed forms of the oven LQG at long horizons (:mod:`rsmhp.studies.horizon.closed_forms`),
+    one row per a: NBO's error limit :math:`r\\sigma^2/(1-(1-a)^2)` (``nbo_limit``) and its share
     reached at each H of ``H_values`` (``nbo_share_H<H>``, %); the first H at which the
     paper's optimal first control is at most ``eps`` of its one-step value
     (``vanishing_H``); the stage-cost variant's stationary gain (``k_inf``) and the first H

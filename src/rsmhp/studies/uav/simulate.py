@@ -18,7 +18,7 @@ import pandas as pd
 from rsmhp.models.uav import methods
 from rsmhp.models.uav.methods import Method
 from rsmhp.models.uav.runs import simulate_runs
-from rsmhp.models.uav.simulation import STEP_VALUES, UAVSetup
+from rsmhp.models.uav.simulation import MODEL_KEYS, STEP_VALUES, UAVSetup
 from rsmhp.pipeline.contracts import Contract
 from rsmhp.pipeline.parallel import chunked
 from rsmhp.pipeline.runstore import RunStore
@@ -52,8 +52,9 @@ RUN_COLUMNS = [
     "plan_seconds",
 ]
 STEP_COLUMNS = ["method", "N_T", "run", "step", *STEP_VALUES, "nit", "kernel_calls"]
-#: config keys of the ``uav`` section a simulation depends on (besides its method and the seed)
-UAV_MODEL_KEYS = ("dt", "g", "aircraft", "target", "sensor", "tracker", "scenario", "planner")
+#: config keys of the ``uav`` section a simulation depends on (besides its method and the seed;
+#: :data:`rsmhp.models.uav.simulation.MODEL_KEYS`)
+UAV_MODEL_KEYS = MODEL_KEYS
 #: wall-time columns: excluded from every determinism check
 NONDETERMINISTIC_COLUMNS = ("plan_seconds",)
 
