@@ -1,7 +1,8 @@
 """The decision study's report sections from their templates (``section_lqg.md``,
 ``section_lqg_appendix.md``, ``section_uav.md``, ``section_uav_appendix.md``): every name a
 template reads is a value the section module passes, a missing value raises, nothing is left
-unfilled, and the findings' optional sentences join with single spaces."""
+unfilled, and the findings' optional sentences join with single spaces. The claims'
+templates (``claims_lqg.md``, ``claims_uav.md``) hold no macro that nothing uses."""
 
 from __future__ import annotations
 
@@ -28,6 +29,7 @@ from tests.studies.decisions.test_decisions_uav import (
     _map_runs,
     _regret_rows,
 )
+from tests.studies.uav.test_uav_claims import unused_macros
 
 PACKAGE = "rsmhp.studies.decisions"
 #: what a template left unfilled would print
@@ -92,6 +94,11 @@ def test_every_template_is_rendered(rendered):
             "section_uav_appendix.md",
         }
     )
+
+
+@pytest.mark.parametrize("module", [claims_lqg, claims_uav], ids=["lqg", "uav"])
+def test_every_macro_of_the_claims_templates_is_used(module):
+    assert unused_macros(module) == set()
 
 
 @pytest.mark.parametrize("study", ["lqg", "uav"])

@@ -1,14 +1,23 @@
 """The ledger fields of claims UAV-1..3 (rsmhp.studies.uav.claims) on small synthetic runs:
 ``n`` is the number of runs the paired comparison's CI rests on (runs with a result for both
 methods, counted in the input), ``margin`` the equivalence margin its rule prints, and no
-UAV claim is a check of our own machinery."""
+UAV claim is a check of our own machinery. Every macro of the claims' template is used."""
 
 from __future__ import annotations
 
+import ast
+import inspect
+from importlib import resources
+from types import ModuleType
+
+import jinja2
 import numpy as np
 import pandas as pd
 import pytest
+from jinja2 import nodes
 
+from rsmhp.report.claimspec import TEXT_FIELDS, ClaimSpec
+from rsmhp.report.templates import CONTINUATION
 from rsmhp.studies.uav import claims as uav_claims
 from rsmhp.studies.uav import summarise as analysis
 
@@ -62,3 +71,32 @@ def test_n_is_the_paired_runs_and_margin_the_rules(margin):
         assert c.key.margin == margin and f"±{margin:g} m" in c.rule
         assert c.key.null == 0.0  # the margin is an equivalence margin, not the null
     assert (claims["UAV-1"].key.n, claims["UAV-2"].key.n, claims["UAV-3"].key.n) == (9, 8, 6)
+
+
+def unused_macros(module: ModuleType) -> set[str]:
+    """The macros of a claims module's template (its ``WORDS``) that nothing uses: neither the
+    module (the macro's name as a string constant), nor a claim spec of the module (the texts
+    ``<prefix>_<field>``), nor another macro."""
+    words = module.WORDS
+    source = resources.files(words.package).joinpath(words.template).read_text(encoding="utf-8")
+    tree = jinja2.Environment().parse(CONTINUATION.sub(" ", source))
+    defined = {m.name for m in tree.find_all(nodes.Macro)}
+    called = {c.node.name for c in tree.find_all(nodes.Call) if isinstance(c.node, nodes.Name)}
+    code = {
+        n.value
+        for n in ast.walk(ast.parse(inspect.getsource(module)))
+        if isinstance(n, ast.Constant) and isinstance(n.value, str)
+    }
+    specs = [
+        s
+        for v in vars(module).values()
+        for s in (v.values() if isinstance(v, dict) else [v])
+        if isinstance(s, ClaimSpec)
+    ]
+    texts = {f"{s.prefix}_{f}" for s in specs for f in TEXT_FIELDS}
+    assert specs and defined
+    return defined - called - code - texts
+
+
+def test_every_macro_of_the_claims_template_is_used():
+    assert unused_macros(uav_claims) == set()

@@ -15,6 +15,7 @@ import pytest
 from jinja2 import meta
 
 from rsmhp.report.templates import render
+from rsmhp.studies.uav import claims as uav_claims
 from rsmhp.studies.uav import section as narrative
 from rsmhp.studies.uav import summarise as analysis
 
@@ -99,8 +100,11 @@ def _filled(text: str) -> None:
 
 
 def test_every_template_is_tested():
+    """Every template beside the modules is a section template tested here, or the words of
+    the claims (``claims.md``, :data:`rsmhp.studies.uav.claims.WORDS`, tested with them)."""
     found = {p.name for p in resources.files(PACKAGE).iterdir() if p.name.endswith(".md")}
-    assert found == set(VALUES)
+    assert uav_claims.WORDS.package == PACKAGE
+    assert found == set(VALUES) | {uav_claims.WORDS.template}
 
 
 @pytest.mark.parametrize("template", sorted(VALUES))

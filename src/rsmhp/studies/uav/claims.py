@@ -1,6 +1,9 @@
-r"""UAV study, claims UAV-1..3: each a paired comparison of :mod:`rsmhp.studies.uav.summarise` whose
-mean difference is the key number, judged by one verdict rule (:func:`paired_rule`, a
-:func:`rsmhp.report.verdicts.ci_side` rule: its printed text and its evaluation are one object).
+r"""UAV study, claims UAV-1..3: each a :class:`~rsmhp.report.claimspec.ClaimSpec`, a paired
+comparison of :mod:`rsmhp.studies.uav.summarise` whose mean difference is the key number, judged
+by one verdict rule (:func:`paired_rule`, a :func:`rsmhp.report.verdicts.ci_side` rule: its
+printed text and its evaluation are one object); the claims' sentences, the key number's name
+and the rule's basis are the macros of ``claims.md`` beside this module
+(:class:`~rsmhp.report.templates.Words`).
 
 For a claim "A has lower error than B" with :math:`d_r = e_r(A) - e_r(B)` and the 95%
 bootstrap CI :math:`[l, h]` of :math:`\bar d`: *equivalent* if :math:`-m < l` and
@@ -24,23 +27,40 @@ The claims are the paper's, about specific families (referenced through their cl
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 import pandas as pd
 
 from rsmhp.models.uav.methods.monte_carlo import MonteCarlo
+from rsmhp.report.claimspec import ClaimSpec, Evidence
 from rsmhp.report.ledger import Claim, KeyNumber
 from rsmhp.report.markdown import fmt, fmt_ci, param_text
 from rsmhp.report.palette import method_label
+from rsmhp.report.templates import Words
 from rsmhp.report.verdicts import Facts, Rule, ci_side
 from rsmhp.studies.uav.summarise import PRUNING, TREND, baseline_name, family_rows, vs_baseline
 
-__all__ = ["KEY", "key_comparisons", "paired_facts", "paired_rule", "short_name", "uav_claims"]
+__all__ = [
+    "CLAIMS",
+    "KEY",
+    "SETUP",
+    "WORDS",
+    "key_comparisons",
+    "paired_facts",
+    "paired_rule",
+    "short_name",
+    "uav_claims",
+]
+
+#: the words of the claims and the rule (macros of ``claims.md`` beside this module)
+WORDS = Words("rsmhp.studies.uav", "claims.md")
 
 #: the key number of every UAV claim, as the rule names it (facts ``mean d_low/high``)
 KEY = "mean d"
 
 #: the setup every UAV claim is tested on
-SETUP = "UAV reconstruction (Sec. III-B), closed loop"
+SETUP = WORDS("setup")
 
 
 def paired_rule(a: str, b: str, margin: float) -> Rule:
@@ -50,8 +70,7 @@ def paired_rule(a: str, b: str, margin: float) -> Rule:
         KEY,
         0.0,
         claimed="below",
-        basis=f"d_r = e_r({a}) − e_r({b}), e_r = run r's average target location error (m); "
-        "95% percentile bootstrap CI over runs",
+        basis=WORDS("paired_rule_basis", a=a, b=b),
         margin=margin,
         margin_text=f"{param_text(margin)} m",
     )
@@ -91,47 +110,46 @@ def short_name(method: str) -> str:
     return method_label(method).replace("RS-MHP ", "").replace("pruned tree", "tree")
 
 
-def _stats(row: pd.Series) -> str:
-    """Secondary numbers of one paired comparison (measured text)."""
+def _stats(row: pd.Series) -> dict[str, str | None]:
+    """Secondary numbers of one paired comparison (the ``stats`` macro; ``p`` ``None``: the
+    Wilcoxon p-value is undefined, every d = 0)."""
     p = row["wilcoxon_p"]
-    ptxt = f"Wilcoxon p = {fmt(p, 2)}" if np.isfinite(p) else "Wilcoxon p undefined (all d = 0)"
-    return (
-        f"{row['comparison']}: mean d {fmt(row['mean_diff'], 2, True)} "
-        f"{fmt_ci(row['ci_low'], row['ci_high'], 2, True)} m, median d "
-        f"{fmt(row['median_diff'], 2, True)} m, d < 0 in {int(row['n_better'])} of "
-        f"{int(row['n_runs'])} runs, {ptxt}"
-    )
+    return {
+        "comparison": row["comparison"],
+        "mean": fmt(row["mean_diff"], 2, True),
+        "ci": fmt_ci(row["ci_low"], row["ci_high"], 2, True),
+        "median": fmt(row["median_diff"], 2, True),
+        "better": str(int(row["n_better"])),
+        "runs": str(int(row["n_runs"])),
+        "p": fmt(p, 2) if np.isfinite(p) else None,
+    }
 
 
-def _alongside(rows: pd.DataFrame) -> str:
-    return "; ".join(
-        f"{r['comparison']}: {fmt(r['mean_diff'], 2, True)} "
-        f"{fmt_ci(r['ci_low'], r['ci_high'], 2, True)} m"
+def _alongside(rows: pd.DataFrame) -> list[dict[str, str]]:
+    """Comparisons reported alongside the key number: mean d and CI (``alongside`` macro)."""
+    return [
+        {
+            "comparison": r["comparison"],
+            "mean": fmt(r["mean_diff"], 2, True),
+            "ci": fmt_ci(r["ci_low"], r["ci_high"], 2, True),
+        }
         for _, r in rows.iterrows()
-    )
+    ]
 
 
-def _dropped(row: pd.Series) -> str:
-    """Runs left out of a paired comparison (a method without a result for them)."""
-    n = int(row.get("n_missing", 0))
-    return f"{n} run(s) without a result for both methods" if n else ""
+def _opposite(rows: pd.DataFrame) -> list[dict[str, str]]:
+    """The comparisons among ``rows`` whose CI lies above 0 (A significantly worse than B)."""
+    return _alongside(rows[rows["ci_low"] > 0])
 
 
-def _claim(
-    cid: str,
-    claim: str,
-    paper: str,
-    row: pd.Series,
-    measured: str,
-    margin: float,
-    dropped: str = "",
-    contrary: str = "",
-) -> Claim:
-    """Claim ``cid`` whose key number is the mean difference of the paired ``row``."""
+def _evidence(row: pd.Series, margin: float, values: dict[str, Any]) -> Evidence:
+    """The evidence of a claim whose key number is the mean difference of the paired ``row``:
+    its rule (first: it checks the margin), key number, facts, and the ``values`` of its
+    texts with the key comparison (``main``) and the runs left out of it (``missing``)."""
     a, b = short_name(row["method"]), short_name(row["baseline"])
-    rule = paired_rule(a, b, margin)  # first: it checks the margin
+    rule = paired_rule(a, b, margin)
     key = KeyNumber(
-        name=f"mean d, e({a}) − e({b})",
+        name=WORDS("key", a=a, b=b),
         value=float(row["mean_diff"]),
         ci_low=float(row["ci_low"]),
         ci_high=float(row["ci_high"]),
@@ -142,19 +160,9 @@ def _claim(
         n=_paired_units(row),
         margin=float(margin),
     )
-    return Claim(
-        id=cid,
-        claim=claim,
-        paper=paper,
-        key=key,
-        verdict=rule.verdict(paired_facts(row)),
-        rule=rule.text(),
-        measured=measured,
-        dropped="; ".join(x for x in (dropped, _dropped(row)) if x),
-        part="paper",
-        setup=SETUP,
-        contrary=contrary,
-    )
+    missing = int(row.get("n_missing", 0))
+    values = {**values, "main": _stats(row), "missing": str(missing) if missing else ""}
+    return Evidence(key=key, facts=paired_facts(row), values=values, rule=rule)
 
 
 def _pick(paired: pd.DataFrame, ab: tuple[str, str]) -> tuple[pd.Series, pd.Series]:
@@ -163,49 +171,34 @@ def _pick(paired: pd.DataFrame, ab: tuple[str, str]) -> tuple[pd.Series, pd.Seri
     return paired[is_key].iloc[0], is_key
 
 
-def _opposite(rows: pd.DataFrame) -> str:
-    """The comparisons among ``rows`` whose CI lies above 0 (A significantly worse than B)."""
-    return _alongside(rows[rows["ci_low"] > 0])
-
-
-def _uav1(summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str], margin: float) -> Claim:
+def _uav1(
+    summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str], margin: float
+) -> Evidence:
+    """RS-MHP with the largest − the smallest N_T; consecutive N_T alongside (UAV-1)."""
     main, is_key = _pick(paired, ab)
     rs = family_rows(summary, MonteCarlo)
-    trend = (paired["purpose"] == TREND) & ~is_key
-    means = ", ".join(f"{r['label']} {fmt(r['mean'], 4)} m" for _, r in rs.iterrows())
-    measured = f"{_stats(main)}; mean e: {means}"
-    if trend.any():
-        measured += f"; consecutive N_T (mean d, CI): {_alongside(paired[trend])}"
-    nts = ", ".join(str(int(n)) for n in rs["N_T"])
-    return _claim(
-        "UAV-1",
-        f"On the UAV reconstruction (closed loop), the average target location error falls "
-        f"as N_T grows (N_T = {nts})",
-        "Sec. III-B, Fig. 4: CDFs of the average location error improve gradually with "
-        "N_T = 50, 100, 250 (H = 6)",
-        main,
-        measured,
-        margin,
-        contrary=_opposite(paired[trend]),
-    )
+    trend = paired[(paired["purpose"] == TREND) & ~is_key]
+    values = {
+        "nts": ", ".join(str(int(n)) for n in rs["N_T"]),
+        "means": [{"label": r["label"], "mean": fmt(r["mean"], 4)} for _, r in rs.iterrows()],
+        "trend": _alongside(trend),
+        "opposite": _opposite(trend),
+    }
+    return _evidence(main, margin, values)
 
 
-def _uav2(paired: pd.DataFrame, ab: tuple[str, str], margin: float) -> Claim:
+def _uav2(
+    summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str], margin: float
+) -> Evidence:
+    """RS-MHP with the largest N_T − NBO; the other methods − NBO alongside (UAV-2)."""
     main, is_key = _pick(paired, ab)
-    others = (paired["purpose"] == vs_baseline()) & ~is_key
-    measured = _stats(main)
-    if others.any():
-        measured += f"; other methods − NBO (mean d, CI): {_alongside(paired[others])}"
-    return _claim(
-        "UAV-2",
-        f"On the UAV reconstruction (closed loop), RS-MHP ({short_name(main['method'])}) "
-        "gives a lower average target location error than NBO",
-        "Sec. III-B, Fig. 5: CDF of the average location error, RS-MHP better than NBO",
-        main,
-        measured,
-        margin,
-        contrary=_opposite(paired[others]),
-    )
+    others = paired[(paired["purpose"] == vs_baseline()) & ~is_key]
+    values = {
+        "short": short_name(main["method"]),
+        "others": _alongside(others),
+        "opposite": _opposite(others),
+    }
+    return _evidence(main, margin, values)
 
 
 def _seconds(summary: pd.DataFrame, method: str) -> float:
@@ -213,55 +206,53 @@ def _seconds(summary: pd.DataFrame, method: str) -> float:
     return float(row["plan_seconds_per_run"].iloc[0]) if len(row) else float("nan")
 
 
-def _compute(summary: pd.DataFrame, pruned: str, flat: str) -> tuple[str, bool]:
+def _compute(summary: pd.DataFrame, pruned: str, flat: str) -> tuple[dict[str, str] | None, bool]:
     """Planning seconds per closed-loop run of the pruned tree and of N_T = M (machine
-    dependent), and whether the pruned tree was the slower."""
+    dependent; the ``compute`` macro, ``None`` without both), and whether the pruned tree was
+    the slower."""
     sp, sf = _seconds(summary, pruned), _seconds(summary, flat)
     if not (np.isfinite(sp) and np.isfinite(sf)):
-        return "", False
-    text = (
-        f"compute: {method_label(pruned)} planned in {fmt(sp, 3)} s per closed-loop run, "
-        f"{method_label(flat)} in {fmt(sf, 3)} s ({fmt(sp / sf, 3)}×; timings of this machine)"
-    )
-    return text, sp > sf
+        return None, False
+    timing = {
+        "pruned": method_label(pruned),
+        "pruned_s": fmt(sp, 3),
+        "flat": method_label(flat),
+        "flat_s": fmt(sf, 3),
+        "ratio": fmt(sp / sf, 3),
+    }
+    return timing, sp > sf
 
 
-def _uav3(summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str], margin: float) -> Claim:
+def _uav3(
+    summary: pd.DataFrame, paired: pd.DataFrame, ab: tuple[str, str], margin: float
+) -> Evidence:
+    """RS-MHP with N_T = M − the pruned tree keeping M; planning time alongside (UAV-3)."""
     main, is_key = _pick(paired, ab)
     others = paired[(paired["purpose"] == PRUNING) & ~is_key]
-    compute, slower = _compute(summary, main["baseline"], main["method"])
-    contrary = [_opposite(paired[(paired["purpose"] == PRUNING) & ~is_key])]
-    if slower:
-        contrary.append(f"{compute}: the pruned tree did not save computation here")
-    measured = _stats(main) + (f"; {compute}" if compute and not slower else "")
-    return _claim(
-        "UAV-3",
-        "On the UAV reconstruction (closed loop), pruning degrades RS-MHP: independent "
-        "trajectories N_T = M give a lower error than the pruned tree keeping M trajectories",
-        "Sec. III-B, text after Fig. 4: the N_T trend suggests pruning would degrade "
-        "RS-MHP but save computation (no experiment shown)",
-        main,
-        measured,
-        margin,
-        dropped=(
-            "further pruned trees, reported but not the key number (the first one is): "
-            + _alongside(others)
-            if len(others)
-            else ""
-        ),
-        contrary="; ".join(c for c in contrary if c),
-    )
+    timing, slower = _compute(summary, main["baseline"], main["method"])
+    values = {
+        "timing": timing,
+        "slower": slower,
+        "others": _alongside(others),
+        "opposite": _opposite(others),
+    }
+    return _evidence(main, margin, values)
+
+
+#: the claims by id, in the ledger's order; each evidence function takes (summary, paired,
+#: (A, B), margin) and brings its rule (the margin is the run's)
+CLAIMS: dict[str, ClaimSpec] = {
+    cid: ClaimSpec(id=cid, setup=SETUP, evidence=evidence, words=WORDS)
+    for cid, evidence in (("UAV-1", _uav1), ("UAV-2", _uav2), ("UAV-3", _uav3))
+}
 
 
 def uav_claims(summary: pd.DataFrame, paired: pd.DataFrame, margin: float) -> list[Claim]:
     """Claims UAV-1..3 by :func:`paired_rule` (those whose methods were run); ``margin`` is
     the equivalence margin (m, ``uav.analysis.equivalence_margin``)."""
     keys = key_comparisons(summary, paired)
-    claims = []
-    if "UAV-1" in keys:
-        claims.append(_uav1(summary, paired, keys["UAV-1"], margin))
-    if "UAV-2" in keys:
-        claims.append(_uav2(paired, keys["UAV-2"], margin))
-    if "UAV-3" in keys:
-        claims.append(_uav3(summary, paired, keys["UAV-3"], margin))
-    return claims
+    return [
+        spec.build(summary, paired, keys[cid], margin)
+        for cid, spec in CLAIMS.items()
+        if cid in keys
+    ]
