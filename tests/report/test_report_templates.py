@@ -1,4 +1,4 @@
-"""The report's own words in templates (rsmhp.report: statements.md, findings.md, ...): short
+"""The report's own words in templates (rsmhp.report: statements.md, report.md, ...): short
 lines, one line per macro, covered by the report rule's code digest, and the statements' words
 taken from their template."""
 
@@ -17,8 +17,15 @@ from rsmhp.report.templates import Words
 ROOT = Path(__file__).resolve().parents[2]
 REPORT = ROOT / "src/rsmhp/report"
 #: the report's templates and the macros' templates among them
-TEMPLATES = ("statements.md", "findings.md", "main_claims.md")
-MACROS = ("statements.md", "main_claims.md")
+TEMPLATES = (
+    "statements.md",
+    "findings.md",
+    "main_claims.md",
+    "report.md",
+    "report_appendix.md",
+    "report_words.md",
+)
+MACROS = ("statements.md", "main_claims.md", "report_words.md")
 
 
 @pytest.mark.parametrize("name", TEMPLATES)

@@ -9,8 +9,11 @@ their fragile verdicts, an index of the studies) and the appendix (:func:`render
 the whole ledger, every claim in detail, each study's section, parameters, provenance) into
 ``results/paper/`` (``make publish`` copies them to the tracked ``paper/``). This module only
 renders: statistics, verdict rules and each study's prose live elsewhere
-(:mod:`rsmhp.core.stats`, :mod:`rsmhp.report.verdicts`, the studies' templates), the
-sentences of "What we found" in ``findings.md`` beside this package.
+(:mod:`rsmhp.core.stats`, :mod:`rsmhp.report.verdicts`, the studies' templates). Its words are
+templates beside it: the two pages (``report.md``, the main text; ``report_appendix.md``, the
+appendix), filled with counts, tables and texts preformatted here; the fixed texts used
+outside them (symbols, verdict policy, caption, table headers) as macros of
+``report_words.md`` (:data:`WORDS`); the sentences of "What we found" in ``findings.md``.
 """
 
 from __future__ import annotations
@@ -27,14 +30,18 @@ from rsmhp.report.ledger import STATEMENT_VERDICTS, VERDICTS, Claim, Section
 from rsmhp.report.markdown import escape
 from rsmhp.report.power import runs_text
 from rsmhp.report.statements import GENERAL_RULE, HEDGED_RULE, Judgement, Statement, judge_all
+from rsmhp.report.templates import Words
 from rsmhp.report.templates import render as render_template
 
 __all__ = [
+    "APPENDIX_TEMPLATE",
     "MAIN_POLICY",
+    "MAIN_TEMPLATE",
     "SUMMARY_CAPTION",
     "SUMMARY_FIGURE",
     "SYMBOLS",
     "VERDICT_POLICY",
+    "WORDS",
     "claims_table",
     "glance_table",
     "render_appendix",
@@ -43,6 +50,24 @@ __all__ = [
     "statements_table",
     "what_we_found",
 ]
+
+
+#: the fixed words of the report outside its pages (``src/rsmhp/report/report_words.md``)
+WORDS = Words("rsmhp.report", "report_words.md")
+#: the main text's page and the appendix's (templates beside this module)
+MAIN_TEMPLATE = "report.md"
+APPENDIX_TEMPLATE = "report_appendix.md"
+
+#: the symbols of the ledger, defined before any claim uses them
+SYMBOLS = WORDS("symbols")
+#: how every verdict is given (the ledger)
+VERDICT_POLICY = WORDS("verdict_policy")
+#: the same principle, short, for the main text (the rules themselves are in the appendix)
+MAIN_POLICY = WORDS("main_policy")
+#: the summary figure the main text opens with (the scenarios study draws it)
+SUMMARY_FIGURE = "scenarios_best"
+#: the caption of the summary figure (main text and the HTML report's landing page)
+SUMMARY_CAPTION = WORDS("summary_caption")
 
 
 def _ledger_number(c: Claim) -> str:
@@ -54,10 +79,7 @@ def claims_table(claims: Iterable[Claim]) -> str:
     with its 95% CI, verdict, the rule that gave it, and the contrary evidence (cells or
     settings whose CI lies on the opposite side). What the paper says is in the statements
     table and in each claim's details (appendix)."""
-    lines = [
-        "| id | claim | setup | our number (95% CI) | verdict | verdict rule | contrary evidence |",
-        "|---|---|---|---|---|---|---|",
-    ]
+    lines = [WORDS("claims_header"), "|---|---|---|---|---|---|---|"]
     for c in claims:
         lines.append(
             f"| {c.id} | {escape(c.claim)} | {escape(c.setup)} "
@@ -70,10 +92,7 @@ def claims_table(claims: Iterable[Claim]) -> str:
 def statements_table(judgements: Iterable[Judgement], appendix: str = "appendix.md") -> str:
     """The paper's statements, each once, judged on the paper's own setups and, apart, on
     variants: the verdict of each kind of setup with its pieces of evidence (linked)."""
-    lines = [
-        "| | the paper says | on the paper's setups | on variants |",
-        "|---|---|---|---|",
-    ]
+    lines = [WORDS("statements_header"), "|---|---|---|---|"]
 
     def cell(verdict: str | None, claims: Sequence[Claim]) -> str:
         if verdict is None:
@@ -83,9 +102,9 @@ def statements_table(judgements: Iterable[Judgement], appendix: str = "appendix.
 
     for j in judgements:
         st = j.statement
+        where = WORDS("statement_where", where=escape(st.where), hedged=st.hedged)
         lines.append(
-            f"| {st.id} | {escape(st.says)} ({escape(st.where)}"
-            f"{'; hedged' if st.hedged else ''}) | {cell(j.verdict, j.counted)} "
+            f"| {st.id} | {escape(st.says)} ({where}) | {cell(j.verdict, j.counted)} "
             f"| {cell(j.on_variants, j.alongside)} |"
         )
     return "\n".join(lines)
@@ -117,10 +136,7 @@ def glance_table(claims: Iterable[Claim], statements: Sequence[Statement] | None
     claims = list(claims)
     by_id = {c.id: c for c in claims}
     judgements, _ = judge_all(claims, statements)
-    lines = [
-        "| | the paper says | on the paper's setups | on variants |",
-        "|---|---|---|---|",
-    ]
+    lines = [WORDS("statements_header"), "|---|---|---|---|"]
     for j in judgements:
         pieces = ", ".join(f"{c.id} {c.verdict}" for c in j.counted)
         var = (
@@ -134,7 +150,7 @@ def glance_table(claims: Iterable[Claim], statements: Sequence[Statement] | None
         )
     ours = [m for m in MAIN_CLAIMS if not m.statement and any(i in by_id for _, i in m.setups)]
     if ours:
-        lines += ["", "| | the benchmark's claim | verdict per setup |", "|---|---|---|"]
+        lines += ["", WORDS("ours_header"), "|---|---|---|"]
         for m in ours:
             per = "; ".join(
                 f"{lab}: {verdict_text(by_id[i])} ({escape(key_text(by_id[i]))})"
@@ -145,53 +161,6 @@ def glance_table(claims: Iterable[Claim], statements: Sequence[Statement] | None
     return "\n".join(lines)
 
 
-#: the symbols of the ledger, defined before any claim uses them
-SYMBOLS = (
-    "**Symbols.** u = (u_0, …, u_{H−1}): the controls over the horizon of H steps; J(u): the "
-    "exact expected cost of u; J_NBO(u): NBO's cost of u (every noise at its mean, 0); "
-    "u* = argmin J: the optimal controls, J(u*) the optimal cost. Oven LQG (Sec. III-A): "
-    "x_{k+1} = (1−a) x_k + a u_k + w_k, w_k ~ N(0, σ²), terminal weight r; "
-    "v_H = σ² Σ_{n<H} (1−a)^{2n}, the variance of the final state, so J − J_NBO = r v_H; "
-    "κ = r²a²‖β‖²/(1 + r a²‖β‖²) with β_k = (1−a)^{H−1−k}, the factor that turns the "
-    "squared mean of the sampled final-state noise into regret. Estimators: P (or n) "
-    "independent trajectories, N draws per tree level, M trajectories kept by pruning, g "
-    "(or p) one trajectory's cost, J_P its average, ε a tolerance. Regret: J(û) − J(u*) of "
-    "the controls û a method chooses; relative regret: regret / J(u*), in percent; pp: "
-    "percentage points (a difference of two percentages). UAV (Sec. III-B): N_T sampled "
-    "target trajectories; e_r the average target location error of run r (m); paired "
-    'difference d_r = e_r(A) − e_r(B), mean d̄ ("mean d" in the rules); Δ: an equivalence '
-    "margin fixed before the run. CI: 95% confidence interval."
-)
-
-
-VERDICT_POLICY = (
-    "Every verdict comes from the rule printed next to it; a rule's cases are read in order "
-    "and the first that holds gives the verdict. The rules share one principle: a claim is "
-    "**supported** only when the 95% confidence interval (CI) of its key number lies "
-    "entirely on the claimed side (or a derived value is met within its statistical "
-    "tolerance), **not supported** when the evidence lies on the opposite side or contradicts "
-    "a closed form, **equivalent** when the CI lies inside an equivalence margin ±Δ fixed "
-    "before the run (whatever the difference is, it is smaller than Δ, so the claimed effect "
-    "is absent at that resolution), and **inconclusive** otherwise. A claim cannot be marked "
-    "supported while its key number's CI contains the value of the opposite claim (checked "
-    "when the report is built). Where a problem or cell is left out of the evidence, the "
-    "claim's details in the appendix name it and say why; cells or settings whose CI lies on "
-    "the side opposite to a claim are named next to it (contrary evidence)."
-)
-
-#: the same principle, short, for the main text (the rules themselves are in the appendix)
-MAIN_POLICY = (
-    "Every verdict comes from a rule fixed before the run that judges it and printed with "
-    "the claim in the appendix (linked): **supported** only when the 95% CI of the key number "
-    "lies entirely on the claimed side, **not supported** when it lies on the opposite side "
-    "(or contradicts a closed form), **equivalent** when it lies inside a margin ±Δ fixed "
-    "before the run, **inconclusive** otherwise. Two rules add a condition: the FR and HZ "
-    "claims are Holm-corrected together (a decisive verdict whose adjusted p is 0.05 or more "
-    "becomes inconclusive, and says so), and DEC-8 needs its CI below 0 in every cell of the "
-    "group as well as on average."
-)
-
-
 def _counts(verdicts: Iterable[str], vocabulary: tuple[str, ...]) -> str:
     verdicts = list(verdicts)
     return ", ".join(
@@ -199,98 +168,9 @@ def _counts(verdicts: Iterable[str], vocabulary: tuple[str, ...]) -> str:
     )
 
 
-#: the summary figure the main text opens with (the scenarios study draws it)
-SUMMARY_FIGURE = "scenarios_best"
-
-
-def _statements_part(
-    judgements: Sequence[Judgement], untested: Sequence[str], appendix: str
-) -> list[str]:
-    on_var = [j for j in judgements if j.on_variants is not None]
-    return [
-        "## The paper's statements, judged where the paper made them",
-        "",
-        f"{len(judgements)} statements of the paper, each judged on the paper's own setups "
-        "(the oven LQG, the estimator problems, the UAV reconstruction with its sensor) and, "
-        "apart, on our variants (footprint sensors, costs outside a proposition's premise); "
-        "a statement's verdict is the one on the paper's setups. On the paper's setups: "
-        + _counts((j.verdict for j in judgements), STATEMENT_VERDICTS)
-        + (
-            f"; on variants ({len(on_var)} statements tested there): "
-            + _counts((j.on_variants for j in on_var), STATEMENT_VERDICTS)
-            if on_var
-            else ""
-        )
-        + f". A general statement's verdict, {GENERAL_RULE.text()}. A hedged one ('may'): "
-        f"{HEDGED_RULE.text()}."
-        + (f" Not tested in this run: {', '.join(untested)}." if untested else "")
-        + " Notes (S1, S2: a gap in the proof of Prop. 1, S5): "
-        + f"[appendix A1]({appendix}#a1-the-papers-statements).",
-        "",
-        statements_table(judgements, appendix),
-        "",
-    ]
-
-
-def _main_claims_part(
-    claims: Sequence[Claim], history: pd.DataFrame | None, appendix: str, run: str | None
-) -> list[str]:
-    rows = main_rows(claims, appendix)
-    shown = {cid for m in MAIN_CLAIMS for _, cid in m.setups}
-    fragile = []
-    if history is not None:
-        for c in claims:
-            if c.id in shown and (line := fragility(c, history, run)):
-                fragile.append(f"- {link(c.id, appendix)} ({c.verdict}): {line}")
-    n_other = sum(1 for c in claims if c.id not in shown and not c.check)
-    n_checks = sum(c.check for c in claims)
-    table = [
-        "| | claim | per setup: key number (95% CI) → verdict; n, n for 80% power |",
-        "|---|---|---|",
-    ]
-    for r in rows:
-        tag = f" ({r['statement']})" if r["statement"] else ""
-        table.append(f"| {r['name']}{tag} | {escape(r['says'])} | {'<br>'.join(r['setups'])} |")
-    return [
-        f"## The main claims ({len(rows)})",
-        "",
-        MAIN_POLICY
-        + " n is the number of paired runs (or belief states) behind a CI; 'for 80% power': "
-        "the n at which the rule would decide with 80% probability if the true difference were "
-        f"the estimate (normal approximation). {n_other} further claims are in the appendix "
-        f"ledger, and {n_checks} checks of our machinery in a part of their own.",
-        "",
-        *table,
-        "",
-        *(
-            [
-                "**Fragile verdicts** (changed across published runs, machines or seed streams; "
-                "`paper/history.csv`):",
-                "",
-                *fragile,
-                "",
-            ]
-            if fragile
-            else []
-        ),
-    ]
-
-
-def _studies_part(sections: Sequence[Section]) -> list[str]:
-    lines = ["## The studies", "", "| study | figures | details |", "|---|---|---|"]
-    for i, s in enumerate(sections, start=1):
-        names = [f.removesuffix(".png") for f in s.figures]
-        figs = ", ".join(f"[{f}](figures/{f}.png)" for f in names) or "–"
-        lines.append(f"| {s.title} | {figs} | appendix C{i} |")
-    return [*lines, ""]
-
-
-#: the caption of the summary figure (main text and the HTML report's landing page)
-SUMMARY_CAPTION = (
-    "The method with the lowest mean closed-loop error per cell, in its family's colour "
-    "(solid: better than every other method, paired 95% t CI over runs; hatched: tied, with "
-    "the number of methods tied)."
-)
+def _statement_rules() -> str:
+    """How a general and a hedged statement are judged (main text and ledger)."""
+    return WORDS("statement_rules", general=GENERAL_RULE.text(), hedged=HEDGED_RULE.text())
 
 
 def what_we_found(
@@ -308,6 +188,56 @@ def what_we_found(
     return render_template("rsmhp.report", "findings.md", **values).strip()
 
 
+def _statements_values(
+    judgements: Sequence[Judgement], untested: Sequence[str], appendix: str
+) -> dict[str, Any]:
+    """The main text's values of the paper's statements: counts by verdict on the paper's
+    setups and on variants, the statements not tested, the table."""
+    on_var = [j for j in judgements if j.on_variants is not None]
+    return {
+        "n_statements": len(judgements),
+        "on_paper": _counts((j.verdict for j in judgements), STATEMENT_VERDICTS),
+        "n_variants": len(on_var),
+        "on_variants": _counts((j.on_variants for j in on_var), STATEMENT_VERDICTS),
+        "rules": _statement_rules(),
+        "untested": ", ".join(untested),
+        "statements_table": statements_table(judgements, appendix),
+    }
+
+
+def _main_claims_values(
+    claims: Sequence[Claim], history: pd.DataFrame | None, appendix: str, run: str | None
+) -> dict[str, Any]:
+    """The main text's values of the main claims: their rows (setups side by side), the
+    claims left to the appendix and the checks, the fragile verdicts among the rows'
+    claims (linked id, verdict, fragility line)."""
+    shown = {cid for m in MAIN_CLAIMS for _, cid in m.setups}
+    fragile = []
+    if history is not None:
+        for c in claims:
+            if c.id in shown and (line := fragility(c, history, run)):
+                fragile.append(f"- {link(c.id, appendix)} ({c.verdict}): {line}")
+    return {
+        "main_policy": MAIN_POLICY,
+        "main": [{**r, "says": escape(r["says"])} for r in main_rows(claims, appendix)],
+        "n_other": sum(1 for c in claims if c.id not in shown and not c.check),
+        "n_checks": sum(c.check for c in claims),
+        "fragile": fragile,
+    }
+
+
+def _run_values(provenance: Mapping[str, str]) -> dict[str, Any]:
+    """The provenance line's values (``?`` where the provenance lacks one)."""
+    get = provenance.get
+    return {
+        "commit": get("commit", "?")[:12],
+        "uncommitted": get("uncommitted changes (outside paper/)") == "yes",
+        "config": get("config sha256", "?"),
+        **{k: get(k, "?") for k in ("python", "numpy", "numba", "blas", "cpu")},
+        "flags": get("cpu flags", "?"),
+    }
+
+
 def render_report(
     sections: Iterable[Section],
     provenance: Mapping[str, str],
@@ -316,130 +246,58 @@ def render_report(
     best: pd.DataFrame | None = None,
     history: pd.DataFrame | None = None,
 ) -> str:
-    """The main text on one page: "What we found" (the answer, each sentence linked to its
-    claims) with the summary figure, the paper's statements judged on its setups and on
-    variants, the main claims (:data:`rsmhp.report.findings.MAIN_CLAIMS`) with their fragile
-    verdicts, an index of the studies and a provenance line; everything else goes to
-    :func:`render_appendix` (file ``appendix``). ``best``: the best-family table of the
-    summary figure; ``history``: :func:`rsmhp.report.history.load_history`."""
+    """The main text on one page (template :data:`MAIN_TEMPLATE`): "What we found" (the
+    answer, each sentence linked to its claims) with the summary figure, the paper's
+    statements judged on its setups and on variants, the main claims
+    (:data:`rsmhp.report.findings.MAIN_CLAIMS`) with their fragile verdicts, an index of the
+    studies and a provenance line; everything else goes to :func:`render_appendix` (file
+    ``appendix``). ``best``: the best-family table of the summary figure; ``history``:
+    :func:`rsmhp.report.history.load_history`."""
     sections = sorted(sections, key=lambda s: (s.order, s.key))
     claims = [c for s in sections for c in s.claims]
     judgements, untested = judge_all(claims, statements)
-    found = what_we_found(sections, statements, best, appendix)
-    figure = []
-    if any(SUMMARY_FIGURE in s.figures for s in sections):
-        figure = [
-            f"![Best family per scenario, budget and horizon](figures/{SUMMARY_FIGURE}.png)",
-            "",
-            f"*{SUMMARY_CAPTION}*",
-            "",
-        ]
     n_bit = sum(c.key.reproducible == "bitwise" for c in claims)
-    parts = [
-        "# rsmhp replication report",
-        "",
-        "Replication of Ragi & Mittelmann, *Random-Sampling Monte-Carlo Tree Search Methods for "
-        "Cost Approximation in Long-Horizon Optimal Control*, IEEE Control Systems Letters 5(5), "
-        "2021, written by the pipeline from one run. This page gives the answer; every claim "
-        "with its rule and numbers, each study's section, tables, parameters and provenance are "
-        f"in [{appendix}]({appendix}). Of the {len(claims)} key numbers {n_bit} reproduce "
-        f"bitwise, {len(claims) - n_bit} statistically (`make verify`).",
-        "",
-        "## What we found",
-        "",
-        found,
-        "",
-        *figure,
-        *_statements_part(judgements, untested, appendix),
-        *_main_claims_part(claims, history, appendix, provenance.get("commit")),
-        *_studies_part(sections),
-        "## Provenance",
-        "",
-        "This run: commit `{}`{}, config sha256 `{}`, Python {}, numpy {}, numba {}, BLAS {}, "
-        "CPU {} ({}); full list in the appendix and `results/provenance.json`.".format(
-            provenance.get("commit", "?")[:12],
-            " (with uncommitted changes)"
-            if provenance.get("uncommitted changes (outside paper/)") == "yes"
-            else "",
-            provenance.get("config sha256", "?"),
-            provenance.get("python", "?"),
-            provenance.get("numpy", "?"),
-            provenance.get("numba", "?"),
-            provenance.get("blas", "?"),
-            provenance.get("cpu", "?"),
-            provenance.get("cpu flags", "?"),
-        ),
-        "",
-    ]
-    return "\n".join(parts)
+    studies = []
+    for s in sections:
+        names = [f.removesuffix(".png") for f in s.figures]
+        studies.append((s.title, ", ".join(f"[{f}](figures/{f}.png)" for f in names) or "–"))
+    return render_template(
+        "rsmhp.report",
+        MAIN_TEMPLATE,
+        appendix=appendix,
+        n_claims=len(claims),
+        n_bitwise=n_bit,
+        n_statistical=len(claims) - n_bit,
+        found=what_we_found(sections, statements, best, appendix),
+        figure=SUMMARY_FIGURE if any(SUMMARY_FIGURE in s.figures for s in sections) else "",
+        caption=SUMMARY_CAPTION,
+        **_statements_values(judgements, untested, appendix),
+        **_main_claims_values(claims, history, appendix, provenance.get("commit")),
+        studies=studies,
+        run=_run_values(provenance),
+    )
 
 
-_REPRO_TEXT = {"bitwise": "bitwise reproducible", "statistical": "statistically reproducible"}
-
-
-def _ledger_part(
-    claims: Sequence[Claim],
-    statements: Sequence[Statement] | None,
-    history: pd.DataFrame | None,
-    run: str | None,
-) -> list[str]:
-    judgements, _ = judge_all(claims, statements)
-    notes = [f"- {j.statement.id}: {j.statement.note}" for j in judgements if j.statement.note]
-    mixed = [f"- {j.statement.id} (mixed): {j.disagreeing}" for j in judgements if j.disagreeing]
-    paper = [c for c in claims if c.part == "paper" and not c.check]
-    beyond = [c for c in claims if c.part == "beyond" and not c.check]
-    checks = [c for c in claims if c.check]
-    fragile = []
-    if history is not None:
-        fragile = [
-            f"- {c.id} ({c.verdict}): {line}"
-            for c in claims
-            if (line := fragility(c, history, run))
-        ]
-    return [
-        "## A. The ledger",
-        "",
-        SYMBOLS,
-        "",
-        VERDICT_POLICY,
-        "",
-        "### A1. The paper's statements",
-        "",
-        f"A general statement's verdict, {GENERAL_RULE.text()}. A hedged one ('may'): "
-        f"{HEDGED_RULE.text()}.",
-        "",
-        statements_table(judgements, ""),
-        "",
-        *(["Where the evidence disagrees:", "", *mixed, ""] if mixed else []),
-        *(["Notes on the statements:", "", *notes, ""] if notes else []),
-        "### A2. Findings",
-        "",
-        f"{len(paper)} claims test the paper's statements on its setups: "
-        + _counts((c.verdict for c in paper), VERDICTS)
-        + f". {len(beyond)} claims go beyond the paper (our derivations, comparisons and model "
-        "variants; the checks of our machinery are not among them): "
-        + _counts((c.verdict for c in beyond), VERDICTS)
-        + ".",
-        "",
-        claims_table(paper + beyond),
-        "",
-        "### A3. Checks of our machinery",
-        "",
-        f"{len(checks)} checks of our simulation, estimators and optimiser against closed forms "
-        "(they test the implementation, not a finding; counted apart): "
-        + _counts((c.verdict for c in checks), VERDICTS)
-        + ".",
-        "",
-        claims_table(checks),
-        "",
-        "### A4. Fragile verdicts",
-        "",
-        "Every claim whose verdict changed across the published runs, the portability drill "
-        "(an emulated other CPU) or seed streams (exploratory against confirmatory), from "
-        "`paper/history.csv`" + (":" if fragile else ": none."),
-        "",
-        *([*fragile, ""] if fragile else []),
-    ]
+def _details(c: Claim, history: pd.DataFrame | None, run: str | None) -> dict[str, Any]:
+    """A claim's details in the appendix: its fields, the verdict as it reads, the key number
+    with its CI, the runs behind it (empty without ``n``), its fragility line (or empty)."""
+    return {
+        "id": c.id,
+        "verdict": verdict_text(c),
+        "check": c.check,
+        "claim": c.claim,
+        "part": c.part,
+        "setup": c.setup,
+        "paper": c.paper,
+        "key": c.key.text(),
+        "reproducible": c.key.reproducible,
+        "rule": c.rule,
+        "runs": runs_text(c.key) if c.key.n is not None else "",
+        "measured": c.measured,
+        "contrary": c.contrary,
+        "dropped": c.dropped,
+        "fragile": fragility(c, history, run) if history is not None else "",
+    }
 
 
 def render_appendix(
@@ -449,63 +307,41 @@ def render_appendix(
     statements: Sequence[Statement] | None = None,
     history: pd.DataFrame | None = None,
 ) -> str:
-    """The appendix: the whole ledger (statements with notes, every finding per model, the
-    checks of our machinery apart, the fragile verdicts), every claim in detail (rule, all
-    measured numbers, what was left out), each study's section with its tables, the
-    parameters of the run and provenance."""
+    """The appendix (template :data:`APPENDIX_TEMPLATE`): the whole ledger (statements with
+    notes, every finding per model, the checks of our machinery apart, the fragile
+    verdicts), every claim in detail (rule, all measured numbers, what was left out), each
+    study's section with its tables, the parameters of the run and provenance."""
     sections = sorted(sections, key=lambda s: (s.order, s.key))
     claims = [c for s in sections for c in s.claims]
     run = provenance.get("commit")
-    parts = [
-        "# rsmhp replication report: appendix",
-        "",
-        "Details behind [the main text](replication.md), from the same run.",
-        "",
-        *_ledger_part(claims, statements, history, run),
-        "## B. Claims in detail",
-        "",
-    ]
-    for c in claims:
-        parts += [
-            f"### {c.id}",
-            "",
-            f"- Verdict: **{verdict_text(c)}**"
-            + (" (a check of our machinery)" if c.check else ""),
-            f"- Claim: {c.claim}",
-            f"- Part: {'the paper' if c.part == 'paper' else 'beyond the paper'}; setup: {c.setup}",
-            f"- Paper: {c.paper}",
-            f"- Key number: {c.key.text()} ({_REPRO_TEXT[c.key.reproducible]})",
-            f"- Verdict rule: {c.rule}",
-        ]
-        if c.key.n is not None:
-            parts.append(f"- Runs: {runs_text(c.key)}")
-        if c.measured:
-            parts.append(f"- Measured: {c.measured}")
-        if c.contrary:
-            parts.append(f"- Contrary evidence: {c.contrary}")
-        if c.dropped:
-            parts.append(f"- Left out: {c.dropped}")
-        if history is not None and (line := fragility(c, history, run)):
-            parts.append(f"- Fragile: {line}")
-        parts.append("")
-    for i, s in enumerate(sections, start=1):
-        parts += [f"## C{i}. {s.title}", "", s.body.strip(), ""]
-        if s.appendix.strip():
-            parts += [s.appendix.strip(), ""]
-    parts += [
-        "## D. Parameters of this run",
-        "",
-        "The validated configuration (defaults filled in), exactly as the pipeline used it:",
-        "",
-        "```yaml",
-        yaml.safe_dump(dict(config), sort_keys=False).strip(),
-        "```",
-        "",
-        "## E. Provenance",
-        "",
-        "Host and date are in `results/provenance.json` (they change every run).",
-        "",
-        *(f"- {k}: `{v}`" for k, v in provenance.items()),
-        "",
-    ]
-    return "\n".join(parts)
+    judgements, _ = judge_all(claims, statements)
+    paper = [c for c in claims if c.part == "paper" and not c.check]
+    beyond = [c for c in claims if c.part == "beyond" and not c.check]
+    checks = [c for c in claims if c.check]
+    details = [_details(c, history, run) for c in claims]
+    return render_template(
+        "rsmhp.report",
+        APPENDIX_TEMPLATE,
+        symbols=SYMBOLS,
+        verdict_policy=VERDICT_POLICY,
+        rules=_statement_rules(),
+        statements_table=statements_table(judgements, ""),
+        mixed=[j for j in judgements if j.disagreeing],
+        notes=[j.statement for j in judgements if j.statement.note],
+        paper=paper,
+        paper_counts=_counts((c.verdict for c in paper), VERDICTS),
+        beyond=beyond,
+        beyond_counts=_counts((c.verdict for c in beyond), VERDICTS),
+        findings_table=claims_table(paper + beyond),
+        checks=checks,
+        checks_counts=_counts((c.verdict for c in checks), VERDICTS),
+        checks_table=claims_table(checks),
+        fragile=[(c, d["fragile"]) for c, d in zip(claims, details, strict=True) if d["fragile"]],
+        details=details,
+        sections=[
+            {"title": s.title, "body": s.body.strip(), "appendix": s.appendix.strip()}
+            for s in sections
+        ],
+        config=yaml.safe_dump(dict(config), sort_keys=False).strip(),
+        provenance=provenance,
+    )
