@@ -20,7 +20,7 @@ import pytest
 from jinja2 import meta
 
 from rsmhp.report import templates
-from rsmhp.studies.horizon import section, section_optimiser
+from rsmhp.studies.horizon import claims, section, section_optimiser
 from rsmhp.studies.horizon.section import HorizonInputs, horizon_section, horizon_tables
 from rsmhp.studies.horizon.section_optimiser import (
     horizon_note,
@@ -288,8 +288,12 @@ def test_optimiser_section_templates_are_complete(opt_summary, calls):
 
 def test_every_template_beside_the_code_is_rendered():
     """The .md files beside the section modules are exactly the templates the tests above
-    render (a stale template would still count in the code digests)."""
-    assert {p.name for p in HERE.glob("*.md")} == {
+    render (a stale template would still count in the code digests), and the words of the
+    claims module (``claims.md``: :class:`rsmhp.report.templates.Words`, rendered by the
+    claims' tests)."""
+    words = {claims.WORDS.template} if claims.WORDS.package == PACKAGE else set()
+    assert words == {"claims.md"}
+    assert {p.name for p in HERE.glob("*.md")} - words == {
         "section.md",
         "section_appendix.md",
         "lqg_limits.md",

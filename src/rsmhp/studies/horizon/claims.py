@@ -1,9 +1,8 @@
 r"""UAV horizon study, claims HZ-1-<model>, HZ-2-<model> and HZ-3-<model>: each a key number from
-:mod:`rsmhp.studies.horizon.summarise_uav` and a verdict rule (:mod:`rsmhp.report.verdicts`). All
-claims are
-beyond the paper (part "beyond"): the paper plans at H = 6 only. Key numbers are statistical
-(sampled hypotheses, optimiser-free but random). H_lo and H_hi are the smallest and largest
-horizons of ``horizon.uav.H``.
+:mod:`rsmhp.studies.horizon.summarise_uav` and a verdict rule (:mod:`rsmhp.report.verdicts`).
+All claims are beyond the paper (part "beyond"): the paper plans at H = 6 only. Key numbers are
+statistical (sampled hypotheses, optimiser-free but random). H_lo and H_hi are the smallest and
+largest horizons of ``horizon.uav.H``.
 
 * **HZ-1** (:func:`hz1_rule`): g = relative RMSE of NBO's cost estimate at H_hi − at H_lo
   (:func:`rsmhp.studies.horizon.summarise_uav.rmse_growth`, the same belief states at both). NBO's
@@ -32,7 +31,7 @@ for the report's Holm correction over the FR and HZ claims
 ``inconclusive`` the doubled one-sided p-value towards the claimed side (1 when the estimate
 lies on the other side). It is also printed in the claim's ``measured`` text, next to the
 percentile-bootstrap CI over runs that the cluster-t CI replaced and the verdict that
-bootstrap CI would give (:func:`horizon_evidence`).
+bootstrap CI would give (:func:`horizon_evidence`, :class:`PrimaryTest`).
 
 Oven LQG (:func:`lqg_horizon_claims`; exact oracle, ``horizon.lqg``):
 
@@ -45,6 +44,12 @@ Oven LQG (:func:`lqg_horizon_claims`; exact oracle, ``horizon.lqg``):
   :math:`\kappa_H v_H / P` at every simulated (a, H, P), up to the longest horizon:
   *supported* if max |z| is within the Bonferroni limit (95% family-wise), *not supported*
   otherwise.
+
+Each claim is a :class:`rsmhp.report.claimspec.ClaimSpec` (:data:`HZ_1` .. :data:`HZ_5`): an
+evidence function of the study's tables (:func:`hz1_evidence` .. :func:`hz5_evidence`: the
+key number, the facts its rule reads and the preformatted values of its texts) and the words
+of ``claims.md`` beside this module (:data:`WORDS`: the claims' sentences, the rules' bases,
+the key numbers' names and the setups).
 """
 
 from __future__ import annotations
@@ -56,11 +61,13 @@ from typing import Any, NamedTuple
 import numpy as np
 import pandas as pd
 
-from rsmhp.models.lqg.regret_summary import z_families
+from rsmhp.models.lqg.regret_summary import ZCheck, z_families
 from rsmhp.models.uav import methods as registry
+from rsmhp.report.claimspec import ClaimSpec, Evidence
 from rsmhp.report.ledger import Claim, KeyNumber
 from rsmhp.report.markdown import fmt, fmt_ci
 from rsmhp.report.palette import method_label
+from rsmhp.report.templates import Words
 from rsmhp.report.verdicts import Case, Rule, ci_side, decisive_p
 from rsmhp.studies.horizon.section_optimiser import TITLE as SPLIT_TITLE
 from rsmhp.studies.horizon.simulate_lqg import pruned_from
@@ -69,25 +76,36 @@ from rsmhp.studies.horizon.summarise_uav import Advantage, Growth, advantage_gro
 
 __all__ = [
     "HZ5_RULE",
+    "HZ_1",
+    "HZ_2",
+    "HZ_3",
+    "HZ_4",
+    "HZ_5",
     "KEY",
-    "Evidence",
+    "WORDS",
+    "PrimaryTest",
     "budget_text",
     "horizon_claims",
     "horizon_evidence",
+    "hz1_evidence",
     "hz1_rule",
+    "hz2_evidence",
     "hz2_rule",
+    "hz3_evidence",
     "hz3_rule",
+    "hz4_evidence",
     "hz4_rule",
+    "hz5_evidence",
     "lqg_horizon_claims",
 ]
 
 KEY = "g"
 
-#: how the HZ-1/HZ-2 CIs are computed (rule texts)
-_CLUSTER_T = "95% cluster-t CI: jackknife over runs, t with runs − 1 df"
+#: the claims' sentences, rule texts, key-number names and setups (``claims.md``)
+WORDS = Words("rsmhp.studies.horizon", "claims.md")
 
 
-class Evidence(NamedTuple):
+class PrimaryTest(NamedTuple):
     """A claim of HZ-1..HZ-3 with its primary test: ``p_value``, the claim's
     ``key.p_value`` (the t-test of 0 behind the verdict with ``df`` degrees of freedom,
     :func:`_verdict_p`); ``[boot_low, boot_high]``, the 95% percentile-bootstrap CI over runs
@@ -102,14 +120,6 @@ class Evidence(NamedTuple):
     boot_verdict: str
 
 
-def _facts(g: Growth) -> dict[str, float]:
-    return {f"{KEY}_low": g.low, f"{KEY}_high": g.high}
-
-
-def _boot_facts(g: Growth) -> dict[str, float]:
-    return {f"{KEY}_low": g.boot_low, f"{KEY}_high": g.boot_high}
-
-
 def _verdict_p(verdict: str, estimate: float, se: float, df: int, claimed: str) -> float:
     """The p-value behind a verdict of the CI rule "above (or below, ``claimed``) 0"
     (:func:`rsmhp.report.verdicts.decisive_p`): the two-sided t-test p-value of 0 for ``supported``
@@ -120,20 +130,39 @@ def _verdict_p(verdict: str, estimate: float, se: float, df: int, claimed: str) 
     return decisive_p(verdict, estimate, se, df, [(0.0, side)])
 
 
-def _test_text(
-    p: float, df: int, boot_low: float, boot_high: float, digits: int, unit: str, verdict: str
-) -> str:
-    """The primary test's p-value and the former bootstrap CI with its verdict (measured)."""
-    return (
-        f"t-test of 0 behind the verdict: p = {fmt(p, 3)} ({df} df, before Holm's correction); "
-        f"the 95% percentile bootstrap over runs gives {fmt_ci(boot_low, boot_high, digits, True)}"
-        f" {unit} (verdict by it: {verdict})"
+def _tested(
+    rule: Rule, name: str, t: Growth | Advantage, claimed: str, scale: float
+) -> tuple[float, dict[str, float], dict[str, Any]]:
+    """The primary test of an estimate ``t`` with a cluster-t CI ``[t.low, t.high]`` under a
+    :func:`~rsmhp.report.verdicts.ci_side` rule of ``name``: its p-value (:func:`_verdict_p`),
+    the facts (the CI; also ``p_value``, ``df`` and the bootstrap CI ``boot_low``,
+    ``boot_high`` times ``scale``, the key number's unit) and the values of the test's text
+    (``p``, ``df``, ``boot_ci`` and ``boot_verdict``, the rule's verdict on the bootstrap CI)."""
+    facts = {f"{name}_low": t.low, f"{name}_high": t.high}
+    p = _verdict_p(rule.verdict(facts), t.mean, t.se, t.df, claimed)
+    boot_low, boot_high = scale * t.boot_low, scale * t.boot_high
+    boot_verdict = rule.verdict({f"{name}_low": t.boot_low, f"{name}_high": t.boot_high})
+    facts |= {"p_value": p, "df": t.df, "boot_low": boot_low, "boot_high": boot_high}
+    values = {
+        "p": fmt(p, 3),
+        "df": t.df,
+        "boot_ci": fmt_ci(boot_low, boot_high, 3, True),
+        "boot_verdict": boot_verdict,
+    }
+    return p, facts, values
+
+
+def _primary_test(spec: ClaimSpec, ev: Evidence) -> PrimaryTest:
+    """The claim of ``spec`` on ``ev`` (an evidence of :func:`_tested`) with its primary test."""
+    f = ev.facts
+    return PrimaryTest(
+        spec.claim(ev),
+        f["p_value"],
+        int(f["df"]),
+        f["boot_low"],
+        f["boot_high"],
+        ev.values["boot_verdict"],
     )
-
-
-def _runs_needed_text(runs: float) -> str:
-    """A run count of :func:`rsmhp.studies.horizon.summarise_uav.runs_to_resolve` in words."""
-    return f"{int(runs)}" if math.isfinite(runs) else "more than 10⁶"
 
 
 def budget_text(planner: Mapping[str, Any] | None) -> str:
@@ -141,102 +170,12 @@ def budget_text(planner: Mapping[str, Any] | None) -> str:
     restarts``); '' without it."""
     if not planner:
         return ""
-    restarts = int(planner.get("restarts", 0) or 0)
-    return f"maxiter {int(planner['maxiter'])}, maxfun {int(planner['maxfun'])}, " + (
-        "no restarts" if restarts == 0 else f"{restarts} restart{'s' * (restarts > 1)}"
+    return WORDS(
+        "budget",
+        maxiter=int(planner["maxiter"]),
+        maxfun=int(planner["maxfun"]),
+        restarts=int(planner.get("restarts", 0) or 0),
     )
-
-
-def _hz3_budget_text(planner: Mapping[str, Any] | None) -> str:
-    """HZ-3's measured text on the optimiser budget of its closed-loop runs."""
-    budget = budget_text(planner)
-    return (
-        "; both planners ran at the optimiser budget of uav.planner"
-        + (f" ({budget})" if budget else "")
-        + " at every H, so D carries each planner's optimisation error besides its "
-        "cost-approximation error (the open-loop split of the two: section "
-        f"'{SPLIT_TITLE}')"
-    )
-
-
-def hz1_rule(h_lo: int, h_hi: int) -> Rule:
-    """HZ-1: NBO's relative RMSE is larger at H_hi than at H_lo."""
-    return ci_side(
-        KEY,
-        0.0,
-        claimed="above",
-        basis=f"g = relative RMSE of NBO's cost estimate at H = {h_hi} − at H = {h_lo}, the same "
-        f"belief states ({_CLUSTER_T})",
-    )
-
-
-def hz2_rule(tree: str, mc: str, h_lo: int, h_hi: int) -> Rule:
-    """HZ-2: the pruned tree's RMSE grows more from H_lo to H_hi than Monte Carlo's."""
-    return ci_side(
-        KEY,
-        0.0,
-        claimed="above",
-        basis=f"g = growth of the relative RMSE from H = {h_lo} to {h_hi} of "
-        f"{method_label(tree)} − that of {method_label(mc)} ({_CLUSTER_T})",
-    )
-
-
-def hz3_rule(mc: str, h_lo: int, h_hi: int) -> Rule:
-    """HZ-3: the closed-loop advantage of ``mc`` over NBO is larger at H_hi than at H_lo."""
-    return ci_side(
-        "D",
-        0.0,
-        claimed="below",
-        basis=f"D = (mean error of {method_label(mc)} − NBO at H = {h_hi}) − (the same at "
-        f"H = {h_lo}), paired over runs (m; 95% Student-t CI over runs)",
-    )
-
-
-def _hz3(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: int,
-         n_boot: int, planner: Mapping[str, Any] | None = None) -> Claim:  # fmt: skip
-    return _hz3_evidence(closed, model, mc, h_lo, h_hi, seed, n_boot, planner).claim
-
-
-def _hz3_evidence(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: int,
-                  n_boot: int, planner: Mapping[str, Any] | None = None) -> Evidence:  # fmt: skip
-    a: Advantage = advantage_growth(closed, model, mc, h_lo, h_hi, seed, n_boot)
-    rule = hz3_rule(mc, h_lo, h_hi)
-    half = (a.high - a.low) / 2
-    verdict = rule.verdict({"D_low": a.low, "D_high": a.high})
-    p = _verdict_p(verdict, a.mean, a.se, a.df, "below")
-    boot_verdict = rule.verdict({"D_low": a.boot_low, "D_high": a.boot_high})
-    claim = Claim(
-        f"HZ-3-{model}",
-        f"On '{model}', the closed-loop advantage of {method_label(mc)} over NBO grows with "
-        f"the horizon (H = {h_lo} to {h_hi})",
-        "Beyond the paper (which plans at H = 6 only): Sec. II argues that NBO ignores the "
-        "uncertainty that accumulates over the horizon",
-        KeyNumber(
-            f"advantage change D, H = {h_lo} → {h_hi}",
-            a.mean,
-            a.low,
-            a.high,
-            unit="m",
-            reproducible="statistical",
-            digits=3,
-            null=0.0,
-            p_value=p,
-            n=_units(a.n),
-        ),
-        verdict,
-        rule.text(),
-        measured=f"{a.n} paired runs; {method_label(mc)} − NBO mean error "
-        f"{fmt(a.d_lo, 3, True)} m at H = {h_lo}, {fmt(a.d_hi, 3, True)} m at H = {h_hi}; "
-        f"CI half-width {fmt(half, 2)} m (SD of the paired change {fmt(a.sd, 3)} m); "
-        + _test_text(p, a.df, a.boot_low, a.boot_high, 3, "m", boot_verdict)
-        + f"; a confirmatory run would need {_runs_needed_text(a.runs_needed)} paired runs to "
-        "detect a D of the observed size with 80% power (paired t-test at 5%; the observed D is "
-        "taken as the true effect, which is optimistic if selection inflated it)"
-        + _hz3_budget_text(planner),
-        part="beyond",
-        setup=f"UAV '{model}', closed loop, H = {h_lo} and {h_hi}",
-    )
-    return Evidence(claim, p, a.df, a.boot_low, a.boot_high, boot_verdict)
 
 
 def _units(n: int) -> int | None:
@@ -262,12 +201,163 @@ def _key(name: str, g: Growth, p_value: float) -> KeyNumber:
     )
 
 
-def _pct(g: Growth) -> Growth:
-    """``g`` with its estimate and both CIs in percentage points."""
-    return g._replace(
-        mean=100 * g.mean, low=100 * g.low, high=100 * g.high, boot_low=100 * g.boot_low,
-        boot_high=100 * g.boot_high,
-    )  # fmt: skip
+def _pct(x: float) -> str:
+    """A relative RMSE ``x`` in percent, three significant digits."""
+    return fmt(100 * x, 3)
+
+
+# ------------------------------------------------------------------ HZ-1
+
+
+def hz1_rule(h_lo: int, h_hi: int) -> Rule:
+    """HZ-1: NBO's relative RMSE is larger at H_hi than at H_lo."""
+    return ci_side(KEY, 0.0, claimed="above", basis=WORDS("hz_1_basis", h_lo=h_lo, h_hi=h_hi))
+
+
+def hz1_evidence(
+    approx: pd.DataFrame, model: str, nbo: str, h_lo: int, h_hi: int, seed: int, n_boot: int
+) -> Evidence:
+    """HZ-1 on ``model``: g = relative RMSE of ``nbo`` at ``h_hi`` − at ``h_lo``
+    (:func:`rsmhp.studies.horizon.summarise_uav.rmse_growth`), in pp."""
+    g = rmse_growth(approx, model, nbo, h_lo, h_hi, seed, n_boot)
+    rule = hz1_rule(h_lo, h_hi)
+    p, facts, test = _tested(rule, KEY, g, "above", 100.0)
+    return Evidence(
+        key=_key(WORDS("hz_1_key", h_lo=h_lo, h_hi=h_hi), g, p),
+        facts=facts,
+        rule=rule,
+        values={
+            "model": model,
+            "h_lo": h_lo,
+            "h_hi": h_hi,
+            "n": g.n,
+            "runs": g.runs,
+            "lo": _pct(g.lo_value),
+            "hi": _pct(g.hi_value),
+            "diff": fmt(100 * g.mean, 3, True),
+            "ci": fmt_ci(100 * g.low, 100 * g.high, 3, True),
+            **test,
+        },
+    )
+
+
+HZ_1 = ClaimSpec(
+    id="HZ-1-{model}",
+    setup=WORDS("uav_states_setup"),
+    evidence=hz1_evidence,
+    words=WORDS,
+    texts="hz_1",
+    part="beyond",
+)
+
+# ------------------------------------------------------------------ HZ-2
+
+
+def hz2_rule(tree: str, mc: str, h_lo: int, h_hi: int) -> Rule:
+    """HZ-2: the pruned tree's RMSE grows more from H_lo to H_hi than Monte Carlo's."""
+    basis = WORDS("hz_2_basis", tree=method_label(tree), mc=method_label(mc), h_lo=h_lo, h_hi=h_hi)
+    return ci_side(KEY, 0.0, claimed="above", basis=basis)
+
+
+def hz2_evidence(
+    approx: pd.DataFrame,
+    model: str,
+    tree: str,
+    mc: str,
+    h_lo: int,
+    h_hi: int,
+    seed: int,
+    n_boot: int,
+) -> Evidence:
+    """HZ-2 on ``model``: d = growth of the relative RMSE of ``tree`` from ``h_lo`` (its first
+    pruned horizon) to ``h_hi`` − that of ``mc``, in pp."""
+    d = rmse_growth(approx, model, tree, h_lo, h_hi, seed, n_boot, minus=mc)
+    g_mc = rmse_growth(approx, model, mc, h_lo, h_hi, seed, n_boot)
+    rule = hz2_rule(tree, mc, h_lo, h_hi)
+    p, facts, test = _tested(rule, KEY, d, "above", 100.0)
+    names = {"tree": method_label(tree), "mc": method_label(mc), "h_lo": h_lo, "h_hi": h_hi}
+    return Evidence(
+        key=_key(WORDS("hz_2_key", **names), d, p),
+        facts=facts,
+        rule=rule,
+        values={
+            **names,
+            "model": model,
+            "n": d.n,
+            "runs": d.runs,
+            "tree_lo": _pct(d.lo_value),
+            "tree_hi": _pct(d.hi_value),
+            "mc_lo": _pct(g_mc.lo_value),
+            "mc_hi": _pct(g_mc.hi_value),
+            **test,
+        },
+    )
+
+
+HZ_2 = ClaimSpec(
+    id="HZ-2-{model}",
+    setup=WORDS("uav_states_setup"),
+    evidence=hz2_evidence,
+    words=WORDS,
+    texts="hz_2",
+    part="beyond",
+)
+
+# ------------------------------------------------------------------ HZ-3
+
+
+def hz3_rule(mc: str, h_lo: int, h_hi: int) -> Rule:
+    """HZ-3: the closed-loop advantage of ``mc`` over NBO is larger at H_hi than at H_lo."""
+    basis = WORDS("hz_3_basis", mc=method_label(mc), h_lo=h_lo, h_hi=h_hi)
+    return ci_side("D", 0.0, claimed="below", basis=basis)
+
+
+def hz3_evidence(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: int,
+                 n_boot: int, planner: Mapping[str, Any] | None = None) -> Evidence:  # fmt: skip
+    """HZ-3 on ``model``: D = closed-loop advantage change of ``mc`` over NBO from ``h_lo`` to
+    ``h_hi`` (:func:`rsmhp.studies.horizon.summarise_uav.advantage_growth`, m); ``planner``:
+    ``uav.planner`` (the budget the measured text names)."""
+    a = advantage_growth(closed, model, mc, h_lo, h_hi, seed, n_boot)
+    rule = hz3_rule(mc, h_lo, h_hi)
+    p, facts, test = _tested(rule, "D", a, "below", 1.0)
+    key = KeyNumber(WORDS("hz_3_key", h_lo=h_lo, h_hi=h_hi), a.mean, a.low, a.high, unit="m",
+                    reproducible="statistical", digits=3, null=0.0, p_value=p,
+                    n=_units(a.n))  # fmt: skip
+    values = {
+        "model": model,
+        "mc": method_label(mc),
+        "h_lo": h_lo,
+        "h_hi": h_hi,
+        "n": a.n,
+        "d_lo": fmt(a.d_lo, 3, True),
+        "d_hi": fmt(a.d_hi, 3, True),
+        "half": fmt((a.high - a.low) / 2, 2),
+        "sd": fmt(a.sd, 3),
+        "runs_needed": f"{int(a.runs_needed)}" if math.isfinite(a.runs_needed) else "",
+        "budget": budget_text(planner),
+        "split_title": SPLIT_TITLE,
+        **test,
+    }
+    return Evidence(key=key, facts=facts, values=values, rule=rule)
+
+
+HZ_3 = ClaimSpec(
+    id="HZ-3-{model}",
+    setup=WORDS("hz_3_setup"),
+    evidence=hz3_evidence,
+    words=WORDS,
+    texts="hz_3",
+    part="beyond",
+)
+
+
+def _hz3(closed: pd.DataFrame, model: str, mc: str, h_lo: int, h_hi: int, seed: int,
+         n_boot: int, planner: Mapping[str, Any] | None = None) -> Claim:  # fmt: skip
+    """HZ-3's claim (:func:`hz3_evidence`, same arguments)."""
+    return HZ_3.build(closed, model, mc, h_lo, h_hi, seed, n_boot, planner)
+
+
+# ------------------------------------------------------------------ HZ-1..HZ-3 of a run
 
 
 def horizon_claims(
@@ -294,84 +384,27 @@ def horizon_evidence(
     seed: int,
     closed: pd.DataFrame | None = None,
     planner: Mapping[str, Any] | None = None,
-) -> list[Evidence]:
+) -> list[PrimaryTest]:
     """The claims of :func:`horizon_claims` (same arguments), each with its primary test's
-    p-value and the percentile-bootstrap CI it replaced (:class:`Evidence`)."""
-    if summary.empty:
-        return []
-    hs = sorted(int(h) for h in summary["H"].unique())
+    p-value and the percentile-bootstrap CI it replaced (:class:`PrimaryTest`): HZ-1 where
+    NBO ran, HZ-2 from the tree's first pruned horizon where both members ran, then HZ-3."""
+    hs = sorted(int(h) for h in summary["H"].unique()) if not summary.empty else []
     if len(hs) < 2:
         return []
     h_lo, h_hi, n_boot = hs[0], hs[-1], int(cfg["bootstrap"])
-    base = registry.baseline()().name
+    nbo = registry.baseline()().name
     rules = cfg.get("claims", {}) or {}
     tree, mc = rules.get("tree"), rules.get("monte_carlo")
     tree_lo = _pruned_from(tree, hs) if tree else None
-    out: list[Evidence] = []
+    out: list[PrimaryTest] = []
     for model in dict.fromkeys(summary["model"]):
-        s = summary[summary["model"] == model]
-        present = set(s["method"])
-        setup = f"UAV '{model}', belief states of NBO runs, H = {h_lo} to {h_hi}"
-        src = "Beyond the paper (which plans at H = 6 only): "
-        if base in present:
-            g = rmse_growth(approx, model, base, h_lo, h_hi, seed, n_boot)
-            rule = hz1_rule(h_lo, h_hi)
-            p = _pct(g)
-            verdict = rule.verdict(_facts(g))
-            p_value = _verdict_p(verdict, g.mean, g.se, g.df, "above")
-            boot_verdict = rule.verdict(_boot_facts(g))
-            claim = Claim(
-                f"HZ-1-{model}",
-                f"On '{model}', NBO's cost-approximation error grows with the horizon "
-                f"(relative RMSE at H = {h_hi} above H = {h_lo})",
-                src + "Sec. II says NBO ignores the uncertainty of the state evolution, "
-                "which accumulates over the horizon",
-                _key(f"NBO relative RMSE, H = {h_hi} − H = {h_lo}", g, p_value),
-                verdict,
-                rule.text(),
-                measured=f"{g.n} belief states of {g.runs} runs; relative RMSE "
-                f"{fmt(100 * g.lo_value, 3)}% at H = {h_lo}, {fmt(100 * g.hi_value, 3)}% at "
-                f"H = {h_hi}; difference {fmt(p.mean, 3, True)} pp "
-                f"{fmt_ci(p.low, p.high, 3, True)}; "
-                + _test_text(p_value, g.df, p.boot_low, p.boot_high, 3, "pp", boot_verdict),
-                part="beyond",
-                setup=setup,
-            )
-            out.append(Evidence(claim, p_value, g.df, p.boot_low, p.boot_high, boot_verdict))
+        present = set(summary.loc[summary["model"] == model, "method"])
+        if nbo in present:
+            ev = hz1_evidence(approx, model, nbo, h_lo, h_hi, seed, n_boot)
+            out.append(_primary_test(HZ_1, ev))
         if tree and mc and {tree, mc} <= present and tree_lo is not None and tree_lo < h_hi:
-            d = rmse_growth(approx, model, tree, tree_lo, h_hi, seed, n_boot, minus=mc)
-            g_mc = rmse_growth(approx, model, mc, tree_lo, h_hi, seed, n_boot)
-            rule = hz2_rule(tree, mc, tree_lo, h_hi)
-            p = _pct(d)
-            verdict = rule.verdict(_facts(d))
-            p_value = _verdict_p(verdict, d.mean, d.se, d.df, "above")
-            boot_verdict = rule.verdict(_boot_facts(d))
-            claim = Claim(
-                f"HZ-2-{model}",
-                f"On '{model}', the error of {method_label(tree)} grows with the horizon "
-                f"more than that of {method_label(mc)} (both M trajectories, H = {tree_lo} "
-                f"to {h_hi})",
-                src + "Sec. II proposes pruning to keep the tree's N^H trajectories "
-                "tractable as H grows",
-                _key(
-                    f"RMSE growth H = {tree_lo} → {h_hi}, {method_label(tree)} − "
-                    f"{method_label(mc)}",
-                    d,
-                    p_value,
-                ),
-                verdict,
-                rule.text(),
-                measured=f"{d.n} belief states of {d.runs} runs; relative RMSE of "
-                f"{method_label(tree)} "
-                f"{fmt(100 * d.lo_value, 3)}% → {fmt(100 * d.hi_value, 3)}%, of "
-                f"{method_label(mc)} {fmt(100 * g_mc.lo_value, 3)}% → "
-                f"{fmt(100 * g_mc.hi_value, 3)}% (H = {tree_lo} → {h_hi}; from H = "
-                f"{tree_lo} the tree has more than M leaves, so it is pruned); "
-                + _test_text(p_value, d.df, p.boot_low, p.boot_high, 3, "pp", boot_verdict),
-                part="beyond",
-                setup=f"UAV '{model}', belief states of NBO runs, H = {tree_lo} to {h_hi}",
-            )
-            out.append(Evidence(claim, p_value, d.df, p.boot_low, p.boot_high, boot_verdict))
+            ev = hz2_evidence(approx, model, tree, mc, tree_lo, h_hi, seed, n_boot)
+            out.append(_primary_test(HZ_2, ev))
     out += _hz3_claims(closed, cfg, mc, seed, n_boot, planner)
     return out
 
@@ -391,7 +424,7 @@ def _hz3_claims(
     seed: int,
     n_boot: int,
     planner: Mapping[str, Any] | None = None,
-) -> list[Evidence]:
+) -> list[PrimaryTest]:
     """HZ-3 on ``horizon.uav.claims.closed_model``, between the smallest and largest H of the
     closed-loop rows (none if either is missing)."""
     model = (cfg.get("claims", {}) or {}).get("closed_model") or ""
@@ -401,35 +434,102 @@ def _hz3_claims(
     hs = sorted(int(h) for h in sel["H"].unique())
     if len(hs) < 2 or mc not in set(sel["method"]):
         return []
-    return [_hz3_evidence(closed, model, mc, hs[0], hs[-1], seed, n_boot, planner)]
+    ev = hz3_evidence(closed, model, mc, hs[0], hs[-1], seed, n_boot, planner)
+    return [_primary_test(HZ_3, ev)]
+
+
+# ------------------------------------------------------------------ HZ-4, HZ-5 (oven LQG)
 
 
 def hz4_rule(N: int, M: int, h_lo: int, h_hi: int) -> Rule:
     """HZ-4: the pruned tree's relative RMSE grows more from H_lo to H_hi than Monte Carlo's
     with as many trajectories (oven LQG, exact J)."""
-    return ci_side(
-        KEY,
-        0.0,
-        claimed="above",
-        basis=f"g = relative-RMSE growth H = {h_lo} → {h_hi}, pruned tree (N = {N}, M = {M}) "
-        f"− Monte Carlo (n = {M}); exact J, bootstrap over replicates",
-    )
+    basis = WORDS("hz_4_basis", N=N, M=M, h_lo=h_lo, h_hi=h_hi)
+    return ci_side(KEY, 0.0, claimed="above", basis=basis)
 
+
+def hz4_evidence(est: pd.DataFrame, a_model: float, N: int, M: int, h_lo: int, h_hi: int,
+                 seed: int, n_boot: int) -> Evidence:  # fmt: skip
+    """HZ-4 at the oven model's ``a_model``: d = growth of the pruned tree's (N, M) relative
+    RMSE from ``h_lo`` to ``h_hi`` − that of Monte Carlo with n = M
+    (:func:`rsmhp.studies.horizon.summarise_lqg.pruned_growth`), in pp."""
+    g = pruned_growth(est, a_model, N, M, h_lo, h_hi, seed, n_boot)
+    # the bootstrap resamples each of the four cells' independent replicates: n is the
+    # replicates per cell (the smallest cell)
+    key = KeyNumber(WORDS("hz_4_key", h_lo=h_lo, h_hi=h_hi), 100 * g.mean, 100 * g.low,
+                    100 * g.high, unit="pp", reproducible="statistical", digits=2, null=0.0,
+                    n=_units(g.replicates))  # fmt: skip
+    values = {
+        "a": f"{a_model:g}",
+        "N": N,
+        "M": M,
+        "h_lo": h_lo,
+        "h_hi": h_hi,
+        "replicates": g.replicates,
+        "tree_lo": _pct(g.pruned_lo),
+        "tree_hi": _pct(g.pruned_hi),
+        "mc_lo": _pct(g.mc_lo),
+        "mc_hi": _pct(g.mc_hi),
+        "mc_growth": fmt(100 * g.mc_growth, 3, True),
+        "mc_ci": fmt_ci(100 * g.mc_growth_low, 100 * g.mc_growth_high, 3, True),
+        "leaves": f"{float(N) ** h_hi:.1e}",
+    }
+    facts = {f"{KEY}_low": g.low, f"{KEY}_high": g.high}
+    return Evidence(key=key, facts=facts, values=values, rule=hz4_rule(N, M, h_lo, h_hi))
+
+
+HZ_4 = ClaimSpec(
+    id="HZ-4", setup=WORDS("hz_4_setup"), evidence=hz4_evidence, words=WORDS, part="beyond"
+)
 
 HZ5_RULE = Rule(
-    basis="max |z| of uniform Monte Carlo's mean regret against κ_H v_H / P over every (a, H, "
-    "P), z = (mean − closed form) / (closed form √(2/R))",
+    basis=WORDS("hz_5_basis"),
     cases=(
         Case(
             "supported",
-            "it is within the Bonferroni limit (95% family-wise)",
+            WORDS("hz_5_rule_supported"),
             lambda f: f["max |z|"] <= f["z limit"],
         ),
     ),
     otherwise="not supported",
 )
 
-_LQG_SRC = "Beyond the paper (its estimator study stops at H = 2): "
+
+def hz5_evidence(regret_summary: pd.DataFrame, z: ZCheck) -> Evidence:
+    """HZ-5: the family ``z`` (``DEC-2`` of :func:`rsmhp.models.lqg.regret_summary.z_families`)
+    of uniform Monte Carlo's mean regret against its closed form, and how close the closed
+    form is to its limit at the largest H."""
+    mc = regret_summary[
+        (regret_summary["method"] == "mc") & (regret_summary["weighting"] == "uniform")
+    ]
+    h_hi = int(mc["H"].max())
+    far = mc[mc["H"] == h_hi]
+    gap = float(np.max(np.abs(far["closed_form"] / far["limit"] - 1.0)))
+    return Evidence(
+        key=KeyNumber(
+            WORDS("hz_5_key", cells=z.cells), z.max_abs_z, reproducible="bitwise", digits=3
+        ),
+        facts={"max |z|": z.max_abs_z, "z limit": z.limit},
+        values={
+            "h_hi": h_hi,
+            "limit": fmt(z.limit, 3),
+            "gap": fmt(100 * gap, 2),
+            "hs": ", ".join(str(int(h)) for h in sorted(mc["H"].unique())),
+            "a_values": ", ".join(f"{a:g}" for a in sorted(mc["a"].unique())),
+            "ps": ", ".join(str(int(p)) for p in sorted(mc["P"].unique())),
+        },
+    )
+
+
+HZ_5 = ClaimSpec(
+    id="HZ-5",
+    setup=WORDS("hz_5_setup"),
+    evidence=hz5_evidence,
+    words=WORDS,
+    rule=HZ5_RULE,
+    part="beyond",
+    check=True,
+)
 
 
 def lqg_horizon_claims(
@@ -451,72 +551,9 @@ def lqg_horizon_claims(
         N, M = int(tree["N"]), int(tree["M"])
         h_lo = pruned_from(N, M, hs)
         if h_lo is not None and h_lo < hs[-1]:
-            g = pruned_growth(est, a_model, N, M, h_lo, hs[-1], seed, int(cfg["bootstrap"]))
-            rule = hz4_rule(N, M, h_lo, hs[-1])
-            out.append(
-                Claim(
-                    "HZ-4",
-                    f"In the oven LQG (a = {a_model:g}), the pruned tree's cost-estimate error "
-                    f"(N = {N}, M = {M}) grows with the horizon more than that of Monte Carlo "
-                    f"with as many trajectories (H = {h_lo} to {hs[-1]})",
-                    _LQG_SRC + "Sec. II prunes the tree to M trajectories so that it stays "
-                    "tractable as H grows",
-                    KeyNumber(
-                        f"RMSE growth H = {h_lo} → {hs[-1]}, pruned tree − Monte Carlo",
-                        100 * g.mean,
-                        100 * g.low,
-                        100 * g.high,
-                        unit="pp",
-                        reproducible="statistical",
-                        digits=2,
-                        null=0.0,
-                        # the bootstrap resamples each of the four cells' independent
-                        # replicates: n is the replicates per cell (the smallest cell)
-                        n=_units(g.replicates),
-                    ),
-                    rule.verdict({f"{KEY}_low": g.low, f"{KEY}_high": g.high}),
-                    rule.text(),
-                    measured=f"{g.replicates} replicates per cell; relative RMSE of the pruned "
-                    f"tree {fmt(100 * g.pruned_lo, 3)}% → {fmt(100 * g.pruned_hi, 3)}%, of "
-                    f"Monte Carlo {fmt(100 * g.mc_lo, 3)}% → {fmt(100 * g.mc_hi, 3)}% "
-                    f"(its own change {fmt(100 * g.mc_growth, 3, True)} pp "
-                    f"{fmt_ci(100 * g.mc_growth_low, 100 * g.mc_growth_high, 3, True)}); "
-                    f"the full tree would have {N}^{hs[-1]} ≈ {float(N) ** hs[-1]:.1e} leaves",
-                    part="beyond",
-                    setup=f"oven LQG, a = {a_model:g}, u = u*(H), H = {h_lo} to {hs[-1]}",
-                )
-            )
+            n_boot = int(cfg["bootstrap"])
+            out.append(HZ_4.build(est, a_model, N, M, h_lo, hs[-1], seed, n_boot))
     z = z_families(regret_summary).get("DEC-2") if not regret_summary.empty else None
     if z is not None:
-        mc = regret_summary[
-            (regret_summary["method"] == "mc") & (regret_summary["weighting"] == "uniform")
-        ]
-        h_hi = int(mc["H"].max())
-        far = mc[mc["H"] == h_hi]
-        gap = float(np.max(np.abs(far["closed_form"] / far["limit"] - 1.0)))
-        out.append(
-            Claim(
-                "HZ-5",
-                "In the oven LQG with open-loop controls, Monte Carlo's decision regret follows "
-                f"κ_H v_H / P at every horizon up to H = {h_hi}, which tends to the limit "
-                "κ_∞ v_∞ / P",
-                _LQG_SRC + "the paper's closed forms are for H = 2; κ_H v_H / P derived here",
-                KeyNumber(
-                    f"max |z| vs κ_H v_H / P over {z.cells} cells",
-                    z.max_abs_z,
-                    reproducible="bitwise",
-                    digits=3,
-                ),
-                HZ5_RULE.verdict({"max |z|": z.max_abs_z, "z limit": z.limit}),
-                HZ5_RULE.text(),
-                measured=f"Bonferroni limit {fmt(z.limit, 3)}; at H = {h_hi} the closed form "
-                f"is within {fmt(100 * gap, 2)}% of its limit; H = "
-                f"{', '.join(str(int(h)) for h in sorted(mc['H'].unique()))}, a = "
-                f"{', '.join(f'{a:g}' for a in sorted(mc['a'].unique()))}, P = "
-                f"{', '.join(str(int(p)) for p in sorted(mc['P'].unique()))}",
-                part="beyond",
-                setup="oven LQG, sample-average argmin over P independent trajectories",
-                check=True,
-            )
-        )
+        out.append(HZ_5.build(regret_summary, z))
     return out

@@ -19,7 +19,12 @@ from rsmhp.report.ledger import Claim, Section
 from rsmhp.report.markdown import ci_cells, fmt, markdown_table, range_text
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import render
-from rsmhp.studies.horizon.claims import Evidence, budget_text, horizon_evidence, lqg_horizon_claims
+from rsmhp.studies.horizon.claims import (
+    PrimaryTest,
+    budget_text,
+    horizon_evidence,
+    lqg_horizon_claims,
+)
 from rsmhp.studies.horizon.figures import FIGURES
 from rsmhp.studies.horizon.section_optimiser import TITLE as SPLIT_TITLE
 from rsmhp.studies.horizon.section_optimiser import horizon_note
@@ -339,7 +344,7 @@ def _runs_values(closed_summary: pd.DataFrame | None) -> list[dict[str, Any]] | 
     return out
 
 
-def _interval_values(evidence: Sequence[Evidence]) -> dict[str, Any] | None:
+def _interval_values(evidence: Sequence[PrimaryTest]) -> dict[str, Any] | None:
     """How the change from the percentile bootstrap over runs to the cluster-t CI changed
     the intervals of HZ-1..HZ-3 (``ratio``: the range of their width ratios, None if none is
     finite) and which verdicts it moved; None without claims."""
@@ -358,13 +363,13 @@ def _interval_values(evidence: Sequence[Evidence]) -> dict[str, Any] | None:
     }
 
 
-def _width_ratio(e: Evidence) -> float:
+def _width_ratio(e: PrimaryTest) -> float:
     k = e.claim.key
     boot = e.boot_high - e.boot_low
     return (k.ci_high - k.ci_low) / boot if boot > 0 else float("nan")
 
 
-def _interval_table(evidence: Sequence[Evidence]) -> str:
+def _interval_table(evidence: Sequence[PrimaryTest]) -> str:
     """HZ-1..HZ-3: key number, cluster-t CI, p-value, percentile-bootstrap CI, their width
     ratio and the verdict of each (Markdown)."""
     rows = pd.DataFrame(
