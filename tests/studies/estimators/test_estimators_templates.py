@@ -1,6 +1,7 @@
 """Estimator-study report section from its templates (``section.md``, ``appendix.md``): every
 value the section computes reaches a template, every placeholder is filled, a missing value
-raises, and each optional sentence appears exactly when its data exist."""
+raises, and each optional sentence appears exactly when its data exist. Every macro of the
+claims' words (``claims.md``) is used, and no template line is longer than 100 characters."""
 
 from __future__ import annotations
 
@@ -198,3 +199,20 @@ def test_appendix_optional_sentences(rendered):
     assert "Best stochastic sampler per problem: none. Exact rules" in text
     text = templates.render(PACKAGE, "appendix.md", **{**none, "weighted_cells": None})
     assert "(f = 1). \n\n**Why pruning" in text
+
+
+def test_every_macro_of_the_claims_template_is_used():
+    """The claims' words (``claims.md``, :data:`rsmhp.studies.estimators.claims.WORDS`) hold no
+    macro that neither the claims module nor one of its specs nor another macro uses."""
+    from rsmhp.studies.estimators import claims
+    from tests.studies.uav.test_uav_claims import unused_macros
+
+    assert claims.WORDS.package == PACKAGE
+    assert unused_macros(claims) == set()
+
+
+@pytest.mark.parametrize("template", ["section.md", "appendix.md", "claims.md"])
+def test_template_lines_are_wrapped(template):
+    """Long lines are continued with a backslash, so a diff shows the sentence that changed."""
+    long = [line for line in _source(template).split("\n") if len(line) > 100]
+    assert long == []
