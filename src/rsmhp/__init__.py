@@ -22,9 +22,9 @@ Sub-packages
                     compiled code can read)
   models            the case studies' models. models.lqg: oven (the scalar oven LQG and its
                     closed forms), linear_quadratic (linear-Gaussian problems with quadratic
-                    cost and their exact oracles), horizon (long-horizon limits), ablation
-                    (the estimator ablation and its per-cell summary), regret and
-                    regret_summary (open-loop regret), recording (rerun trees).
+                    cost and their exact oracles), ablation (the estimator ablation and its
+                    per-cell summary), regret and regret_summary (open-loop regret),
+                    recording (rerun trees).
                     models.uav: kinematics, target, sensor, tracker (filterpy, the reference),
                     stepper (compiled closed-loop step), kernel (numpy oracle), fused (compiled
                     weighted cost + exact gradient), planner (Planner and Optimiser
@@ -33,8 +33,10 @@ Sub-packages
                     which families take it), runs (closed-loop runs through the
                     run store: their key, shared by the studies), scoring (open-loop scoring
                     of belief states, shared by the studies), recording
-  pipeline          workflow support: config (config files and schema checks, ``python -m
-                    rsmhp.pipeline.config FILE``), contracts (what each intermediate holds),
+  pipeline          workflow support: config (config files and schema checks, the shared
+                    sections' and, found by package, every study's, ``python -m
+                    rsmhp.pipeline.config FILE``), config_layout (keys that moved, the view
+                    of a config its hash is taken of), contracts (what each intermediate holds),
                     io (atomic writers, checked readers), code_digest (the code each rule
                     depends on, per method family where a rule runs some), runstore (the
                     content-addressed store of computed runs, shared by the rules), parallel
@@ -48,18 +50,23 @@ Sub-packages
                     statements (the paper's statements judged on its setups and on variants),
                     findings (the main claims, "What we found"), power (runs at 80% power),
                     history (earlier verdicts, fragility), render (main text, appendix,
-                    glance table), html (the HTML report's landing page), templates (Jinja2),
+                    glance table), html (the HTML report's landing page), templates (Jinja2;
+                    Words, a study's claim sentences as macros), claimspec (a claim as
+                    data: id, setup, rule, evidence function, words),
                     markdown (number formatting, tables), palette (one colour and label per
                     method), figures (theme, save_figure), provenance, readme (``make
                     publish``), verify (``make verify``), portability (``make portability``)
   studies           one package per study, each with simulate (config -> tidy tables),
                     summarise (tables -> statistics), claims (key numbers and verdicts),
-                    figures, section (the report section, prose in Markdown templates):
+                    figures, section (the report section, prose in Markdown templates),
+                    checks (its config checks and memory estimates; the pipeline asks every
+                    study's):
                     lqg (Fig. 3), estimators (the estimator ablation), uav (Figs. 4-5),
                     decisions (LQG and UAV regret, the sensitivity map), frontier (equal
                     compute: exploratory frontier, tuning, confirmatory run, the published
                     reference and the comparison of new planners with it), horizon (long
-                    horizons, LQG and UAV, and the optimiser split), scenarios (the best
+                    horizons, LQG and UAV, and the optimiser split; closed_forms, the oven
+                    LQG's long-horizon limits), scenarios (the best
                     method per cell and the probability of beating NBO across scenarios)
   testing           check_method: the conformance check of a planning-method family (run it
                     first on a new one, in this repository or a plugin package)
