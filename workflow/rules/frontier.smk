@@ -398,8 +398,11 @@ rule frontier_confirm_summary:
         ),
         # the FR and HZ claims published at 76a0c01 (exploratory; kept, not counted), and
         # the first confirmatory run's FR claims (superseded by the second preregistration)
-        exploratory="paper/exploratory/claims_76a0c01.json",
-        superseded="paper/superseded/claims_confirm1.json",
+        # (published files of this checkout, wherever the workflow runs: -d elsewhere)
+        exploratory=os.path.join(
+            workflow.basedir, "paper/exploratory/claims_76a0c01.json"
+        ),
+        superseded=os.path.join(workflow.basedir, "paper/superseded/claims_confirm1.json"),
     output:
         summary="results/frontier/confirm_summary.csv",
         ladder="results/frontier/confirm_ladder.csv",

@@ -1,8 +1,9 @@
 """Report prose as Markdown templates (Jinja2) beside each study's code.
 
 A study's section text lives in ``src/rsmhp/studies/<study>/*.md``, filled with generated values
-and tables by :func:`render`; no sentence of a section is split across Python string literals
-(the claims' own texts, in the ledger, are still written in each study's ``claims`` module).
+and tables by :func:`render`; no sentence of a section is split across Python string literals,
+and a claim's texts in the ledger are macros of the study's ``claims*.md`` (:class:`Words`,
+:mod:`rsmhp.report.claimspec`).
 The templates are part of the code a rule depends on: :mod:`rsmhp.pipeline.code_digest` counts
 a ``*.md`` file beside a module as code of the modules that name it (``render(...,
 "section.md")``), so an edit of the prose reruns the rules that render it and no simulation (a
