@@ -23,12 +23,20 @@ claims are beyond the paper (part "beyond"), one per model variant of the study.
 Timing enters no verdict (times differ across machines, decisions reproduce): each claim
 states the members' measured milliseconds per step against the budget, and a member over
 the budget, or a larger member of its family within it, is named as contrary evidence.
+
+Each claim is a :class:`rsmhp.report.claimspec.ClaimSpec` (:data:`FR_1` .. :data:`FR_3`, and
+:data:`FR_CONFIRM` for the preregistered claims of the confirmatory run): an evidence function
+(:func:`fr1_evidence` .. :func:`fr3_evidence`, :func:`confirm_evidence`: the key number, the
+facts its rule reads and the preformatted values of its texts) and the words of ``claims.md``
+beside this module (:data:`WORDS`: the claims' sentences, contrary evidence, the rules' bases,
+the key numbers' names and the setups).
 """
 
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from typing import Any
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
 
 import pandas as pd
 
@@ -38,17 +46,43 @@ from rsmhp.models.uav.methods.monte_carlo import MonteCarlo
 from rsmhp.models.uav.methods.rqmc import RQMC
 from rsmhp.models.uav.methods.sigma_points import SigmaPoints
 from rsmhp.models.uav.methods.tree_search import TreeSearch
+from rsmhp.report.claimspec import ClaimSpec, Evidence
 from rsmhp.report.ledger import Claim, KeyNumber
 from rsmhp.report.markdown import fmt, fmt_ci, param_text
 from rsmhp.report.palette import method_label
+from rsmhp.report.templates import Words
 from rsmhp.report.verdicts import Rule, ci_side, decisive_p, non_inferior
-from rsmhp.studies.frontier.summarise import Paired, budget_check, paired_difference
+from rsmhp.studies.frontier.summarise import (
+    Paired,
+    budget_check,
+    paired_configs,
+    paired_difference,
+    prob_improvement,
+)
+
+if TYPE_CHECKING:
+    from rsmhp.pipeline.protocol import Configuration
 
 __all__ = [
+    "CONFIRM_TESTS",
+    "FR_1",
+    "FR_2",
+    "FR_3",
+    "FR_CONFIRM",
     "KEY",
+    "WORDS",
+    "Comparison",
+    "ExploratoryRun",
+    "PreregisteredRule",
     "budget_member",
+    "confirm_claims",
+    "confirm_evidence",
+    "confirm_rule",
+    "fr1_evidence",
     "fr1_rule",
+    "fr2_evidence",
     "fr2_rule",
+    "fr3_evidence",
     "fr3_rule",
     "frontier_claims",
     "paired_facts",
@@ -56,6 +90,9 @@ __all__ = [
 
 #: the key number of every claim here, as the rules name it (facts ``mean d_low/high``)
 KEY = "mean d"
+
+#: the claims' sentences, rule bases, key-number names and setups (``claims.md``)
+WORDS = Words("rsmhp.studies.frontier", "claims.md")
 
 
 def paired_facts(d: Paired) -> dict[str, float]:
@@ -69,7 +106,7 @@ def fr1_rule(margin_pp: float) -> Rule:
         KEY,
         0.0,
         claimed="below",
-        basis="d = relative regret of RQMC − RS-MHP (budget members), paired per belief state (pp)",
+        basis=WORDS("fr_1_basis"),
         margin=margin_pp,
         margin_text=f"{param_text(margin_pp)} pp",
     )
@@ -81,8 +118,7 @@ def fr2_rule(margin_pp: float, reference: str) -> Rule:
         KEY,
         margin_pp,
         margin_text=f"{param_text(margin_pp)} pp",
-        basis=f"d = relative regret of the sigma points − {method_label(reference)}, paired "
-        "per belief state (pp)",
+        basis=WORDS("fr_2_basis", reference=method_label(reference)),
     )
 
 
@@ -92,8 +128,7 @@ def fr3_rule(margin_m: float) -> Rule:
         KEY,
         0.0,
         claimed="below",
-        basis="d = closed-loop mean location error of the tree search − RS-MHP (budget "
-        "members), paired over runs (m)",
+        basis=WORDS("fr_3_basis"),
         margin=margin_m,
         margin_text=f"{param_text(margin_m)} m",
     )
@@ -149,164 +184,163 @@ def _p_noninferior(d: Paired, verdict: str, margin: float) -> float:
     return decisive_p(verdict, d.mean, d.se, d.df, [(margin, side)])
 
 
-def _timing(check: pd.DataFrame, model: str, names: Sequence[str], budget: float) -> str:
-    """``RQMC N_T=256 0.73 ms, RS-MHP N_T=256 0.49 ms per step (budget 1.25 ms)``."""
-    c = check[check["model"] == model].set_index("member")
-    parts = [
-        f"{method_label(n)} {fmt(float(c.loc[n, 'plan_ms']), 3)} ms" for n in names if n in c.index
-    ]
-    return f"{', '.join(parts)} per step, median over runs (budget {param_text(budget)} ms)"
-
-
-def _timing_contrary(check: pd.DataFrame, model: str, names: Sequence[str]) -> list[str]:
-    """A member over the budget on this run, or a larger member of its family within it."""
-    c = check[check["model"] == model].set_index("member")
-    out = []
-    for n in names:
-        if n not in c.index:
-            continue
-        r = c.loc[n]
-        if not bool(r["fits"]):
-            out.append(f"{method_label(n)} took {fmt(float(r['plan_ms']), 3)} ms, over the budget")
-        elif r["largest_fitting"] and r["largest_fitting"] != n:
-            out.append(
-                f"{method_label(str(r['largest_fitting']))} ({fmt(float(r['largest_ms']), 3)} "
-                f"ms) also fits the budget on this run"
-            )
-    return out
-
-
 def _diff_text(d: Paired, unit: str, digits: int = 3) -> str:
+    """``+1.23 unit [+0.50, +2.00]``: a paired difference with its CI."""
     return f"{fmt(d.mean, digits, True)} {unit} {fmt_ci(d.low, d.high, digits, True)}"
 
 
-def _model_claims(
-    model: str,
-    runs: pd.DataFrame,
-    regret: pd.DataFrame,
-    summary: pd.DataFrame,
-    check: pd.DataFrame,
-    members: Sequence[str],
-    cfg: Mapping[str, Any],
-    seed: int,
-    n_boot: int,
-) -> list[Claim]:
-    rules = cfg["claims"]
-    budget = float(cfg["budget"]["ms_per_step"])
-    margin_pp, margin_m = float(rules["margin_pp"]), float(rules["margin_m"])
-    mc = budget_member(members, MonteCarlo)
-    rqmc = budget_member(members, RQMC)
-    sigma = budget_member(members, SigmaPoints)
-    dpw = budget_member(members, TreeSearch)
-    ref = str(rules["sigma_reference"])
-    run_methods = set(summary.loc[summary["model"] == model, "method"])
-    setup = f"UAV '{model}', budget {param_text(budget)} ms per step"
-    src = "Beyond the paper (its UAV study compares NBO, RS-MHP and pruning only): "
-    out: list[Claim] = []
+# ------------------------------------------------------------ the exploratory run: FR-1..3
 
-    def diff(table: pd.DataFrame, a: str, b: str, measure: str) -> Paired:
-        return paired_difference(table, model, a, b, measure, seed, n_boot)
 
-    if mc and rqmc and {mc, rqmc} <= run_methods:
-        d = diff(regret, rqmc, mc, "regret")
-        e = diff(runs, rqmc, mc, "error")
-        rule = fr1_rule(margin_pp)
-        verdict = rule.verdict(paired_facts(d))
-        out.append(
-            Claim(
-                f"FR-1-{model}",
-                f"On '{model}', within the planning budget, {method_label(rqmc)} chooses better "
-                f"plans than {method_label(mc)} (lower open-loop regret)",
-                src + "the estimator study's variance reduction of scrambled Sobol' points, "
-                "tested as a planner at equal compute",
-                _key(
-                    f"regret {method_label(rqmc)} − {method_label(mc)}, paired mean",
-                    d,
-                    "pp",
-                    0.0,
-                    _p_side(d, verdict, margin_pp),
-                    margin_pp,
-                ),
-                verdict,
-                rule.text(),
-                measured=f"{d.n} belief states; closed loop {method_label(rqmc)} − "
-                f"{method_label(mc)} = {_diff_text(e, 'm')} over {e.n} paired runs; "
-                f"{_timing(check, model, [rqmc, mc], budget)}",
-                part="beyond",
-                setup=setup,
-                contrary="; ".join(_timing_contrary(check, model, [rqmc, mc])),
-            )
-        )
-    if sigma and ref in run_methods and sigma in run_methods:
-        d = diff(regret, sigma, ref, "regret")
-        e = diff(runs, sigma, ref, "error")
-        rule = fr2_rule(margin_pp, ref)
-        verdict = rule.verdict(paired_facts(d))
-        out.append(
-            Claim(
-                f"FR-2-{model}",
-                f"On '{model}', the sigma points decide as well as {method_label(ref)}, up to "
-                f"{param_text(margin_pp)} pp of open-loop regret",
-                src + "a deterministic cubature set of the joint belief in place of random "
-                "hypotheses",
-                _key(
-                    f"regret sigma points − {method_label(ref)}, paired mean",
-                    d,
-                    "pp",
-                    margin_pp,
-                    _p_noninferior(d, verdict, margin_pp),
-                    None,
-                ),
-                verdict,
-                rule.text(),
-                measured=f"{d.n} belief states; closed loop sigma points − {method_label(ref)} "
-                f"= {_diff_text(e, 'm')} over {e.n} paired runs; "
-                f"{_timing(check, model, [sigma, ref], budget)}",
-                part="beyond",
-                setup=setup,
-                contrary="; ".join(_timing_contrary(check, model, [sigma])),
-            )
-        )
-    if mc and dpw and {mc, dpw} <= run_methods:
-        e = diff(runs, dpw, mc, "error")
-        d = diff(regret, dpw, mc, "regret")
-        rule = fr3_rule(margin_m)
-        verdict = rule.verdict(paired_facts(e))
-        s = summary[summary["model"] == model].set_index("method")
-        # the open-loop regret scores all H steps of a plan, also those below the depth the
-        # tree search reached (its tail comes from the rollout policy): it is reported, not
-        # named as contrary evidence to a closed-loop claim
-        contrary = _timing_contrary(check, model, [dpw, mc])
-        out.append(
-            Claim(
-                f"FR-3-{model}",
-                f"On '{model}', within the planning budget, {method_label(dpw)} (PFT-DPW) tracks "
-                f"better than {method_label(mc)} (lower closed-loop error)",
-                src + "the paper calls RS-MHP a Monte-Carlo tree search but never compares it "
-                "with the progressive-widening tree search used for continuous belief spaces",
-                _key(
-                    f"error {method_label(dpw)} − {method_label(mc)}, paired mean",
-                    e,
-                    "m",
-                    0.0,
-                    _p_side(e, verdict, margin_m),
-                    margin_m,
-                ),
-                verdict,
-                rule.text(),
-                measured=f"{e.n} paired runs; mean error {fmt(float(s.loc[dpw, 'mean_error']))} "
-                f"vs {fmt(float(s.loc[mc, 'mean_error']))} m; track lost in "
-                f"{fmt(100 * float(s.loc[dpw, 'lost_rate']), 3)}% vs "
-                f"{fmt(100 * float(s.loc[mc, 'lost_rate']), 3)}% of runs; open-loop relative "
-                f"regret {method_label(dpw)} − {method_label(mc)} = {_diff_text(d, 'pp', 2)} "
-                f"over {d.n} belief states (all H steps of each plan scored, also those below "
-                f"the tree's depth); {_timing(check, model, [dpw, mc], budget)}",
-                part="beyond",
-                setup=setup,
-                contrary="; ".join(contrary),
-            )
-        )
-    return out
+@dataclass(frozen=True, eq=False)
+class ExploratoryRun:
+    """What the FR claims of one ``model`` read from the exploratory run: its ``runs`` and
+    ``regret`` tables (every model), ``summary``
+    (:func:`rsmhp.studies.frontier.summarise.summarize_frontier`), the budget ``check``
+    (:func:`rsmhp.studies.frontier.summarise.budget_check`), the planning ``budget`` (ms per
+    step) and the bootstrap's ``seed`` and ``n_boot``."""
+
+    runs: pd.DataFrame
+    regret: pd.DataFrame
+    summary: pd.DataFrame
+    check: pd.DataFrame
+    model: str
+    budget: float
+    seed: int
+    n_boot: int
+
+    def diff(self, table: pd.DataFrame, a: str, b: str, measure: str) -> Paired:
+        """d = ``measure`` of ``a`` − that of ``b`` on the model, paired
+        (:func:`rsmhp.studies.frontier.summarise.paired_difference`)."""
+        return paired_difference(table, self.model, a, b, measure, self.seed, self.n_boot)
+
+    def timing(self, names: Sequence[str]) -> dict[str, Any]:
+        """The members' median planning ms per step against the budget (the ``timing``
+        macro's values)."""
+        c = self.check[self.check["model"] == self.model].set_index("member")
+        members = [
+            {"label": method_label(n), "ms": fmt(float(c.loc[n, "plan_ms"]), 3)}
+            for n in names
+            if n in c.index
+        ]
+        return {"members": members, "budget": param_text(self.budget)}
+
+    def contrary(self, names: Sequence[str]) -> list[dict[str, Any]]:
+        """A member over the budget on this run (``over``), or a larger member of its family
+        within it (the ``timing_contrary`` macro's values)."""
+        c = self.check[self.check["model"] == self.model].set_index("member")
+        out: list[dict[str, Any]] = []
+        for n in names:
+            if n not in c.index:
+                continue
+            r = c.loc[n]
+            if not bool(r["fits"]):
+                out.append(
+                    {"over": True, "label": method_label(n), "ms": fmt(float(r["plan_ms"]), 3)}
+                )
+            elif r["largest_fitting"] and r["largest_fitting"] != n:
+                label, ms = method_label(str(r["largest_fitting"])), float(r["largest_ms"])
+                out.append({"over": False, "label": label, "ms": fmt(ms, 3)})
+        return out
+
+    def values(self) -> dict[str, Any]:
+        """The values every FR claim's id and setup read."""
+        return {"model": self.model, "budget": param_text(self.budget)}
+
+
+def fr1_evidence(run: ExploratoryRun, rqmc: str, mc: str, margin_pp: float) -> Evidence:
+    """FR-1: d = open-loop relative regret of ``rqmc`` − ``mc`` (pp), paired per belief
+    state; the closed-loop difference beside it."""
+    d = run.diff(run.regret, rqmc, mc, "regret")
+    e = run.diff(run.runs, rqmc, mc, "error")
+    rule = fr1_rule(margin_pp)
+    p = _p_side(d, rule.verdict(paired_facts(d)), margin_pp)
+    names = {"rqmc": method_label(rqmc), "mc": method_label(mc)}
+    return Evidence(
+        key=_key(WORDS("fr_1_key", **names), d, "pp", 0.0, p, margin_pp),
+        facts=paired_facts(d),
+        rule=rule,
+        values={
+            **run.values(),
+            **names,
+            **run.timing([rqmc, mc]),
+            "states": d.n,
+            "error": _diff_text(e, "m"),
+            "runs": e.n,
+            "contrary": run.contrary([rqmc, mc]),
+        },
+    )
+
+
+def fr2_evidence(run: ExploratoryRun, sigma: str, ref: str, margin_pp: float) -> Evidence:
+    """FR-2: d = open-loop relative regret of ``sigma`` − ``ref`` (pp), paired per belief
+    state, against the non-inferiority margin; the closed-loop difference beside it."""
+    d = run.diff(run.regret, sigma, ref, "regret")
+    e = run.diff(run.runs, sigma, ref, "error")
+    rule = fr2_rule(margin_pp, ref)
+    p = _p_noninferior(d, rule.verdict(paired_facts(d)), margin_pp)
+    reference = method_label(ref)
+    return Evidence(
+        key=_key(WORDS("fr_2_key", reference=reference), d, "pp", margin_pp, p, None),
+        facts=paired_facts(d),
+        rule=rule,
+        values={
+            **run.values(),
+            **run.timing([sigma, ref]),
+            "reference": reference,
+            "margin": param_text(margin_pp),
+            "states": d.n,
+            "error": _diff_text(e, "m"),
+            "runs": e.n,
+            "contrary": run.contrary([sigma]),
+        },
+    )
+
+
+def fr3_evidence(run: ExploratoryRun, dpw: str, mc: str, margin_m: float) -> Evidence:
+    """FR-3: d = closed-loop mean location error of ``dpw`` − ``mc`` (m), paired over runs;
+    the open-loop regret difference beside it (reported, no contrary evidence: it scores plan
+    steps below the tree's depth too)."""
+    e = run.diff(run.runs, dpw, mc, "error")
+    d = run.diff(run.regret, dpw, mc, "regret")
+    rule = fr3_rule(margin_m)
+    p = _p_side(e, rule.verdict(paired_facts(e)), margin_m)
+    s = run.summary[run.summary["model"] == run.model].set_index("method")
+    names = {"dpw": method_label(dpw), "mc": method_label(mc)}
+    return Evidence(
+        key=_key(WORDS("fr_3_key", **names), e, "m", 0.0, p, margin_m),
+        facts=paired_facts(e),
+        rule=rule,
+        values={
+            **run.values(),
+            **names,
+            **run.timing([dpw, mc]),
+            "runs": e.n,
+            "error_dpw": fmt(float(s.loc[dpw, "mean_error"])),
+            "error_mc": fmt(float(s.loc[mc, "mean_error"])),
+            "lost_dpw": fmt(100 * float(s.loc[dpw, "lost_rate"]), 3),
+            "lost_mc": fmt(100 * float(s.loc[mc, "lost_rate"]), 3),
+            "regret": _diff_text(d, "pp", 2),
+            "states": d.n,
+            "contrary": run.contrary([dpw, mc]),
+        },
+    )
+
+
+def _explore_spec(n: int, evidence: Any) -> ClaimSpec:
+    return ClaimSpec(
+        id=f"FR-{n}-{{model}}",
+        setup=WORDS("explore_setup"),
+        evidence=evidence,
+        words=WORDS,
+        texts=f"fr_{n}",
+        part="beyond",
+    )
+
+
+FR_1 = _explore_spec(1, fr1_evidence)
+FR_2 = _explore_spec(2, fr2_evidence)
+FR_3 = _explore_spec(3, fr3_evidence)
 
 
 def frontier_claims(
@@ -318,18 +352,33 @@ def frontier_claims(
 ) -> list[Claim]:
     """FR-1..3 per model of ``summary`` (module doc), in the config's model order. ``runs``
     and ``regret``: the study's tables of every model; ``summary``:
-    :func:`rsmhp.studies.frontier.summarise.summarize_frontier`; ``cfg``: ``frontier``."""
+    :func:`rsmhp.studies.frontier.summarise.summarize_frontier`; ``cfg``: ``frontier``. A
+    claim whose members are not both budget members that ran is left out."""
     for key in ("budget", "claims", "bootstrap"):
         if key not in cfg:
             raise ValueError(f"frontier lacks {key!r} (the config schema fills it)")
     members = list(cfg["budget"]["members"])
     if summary.empty or not members:
         return []
-    check = budget_check(summary, members, float(cfg["budget"]["ms_per_step"]))
-    n_boot = int(cfg["bootstrap"])
+    budget, rules = float(cfg["budget"]["ms_per_step"]), cfg["claims"]
+    check = budget_check(summary, members, budget)
+    margin_pp, margin_m = float(rules["margin_pp"]), float(rules["margin_m"])
+    mc, rqmc, sigma, dpw = (
+        budget_member(members, family) for family in (MonteCarlo, RQMC, SigmaPoints, TreeSearch)
+    )
+    ref = str(rules["sigma_reference"])
     out: list[Claim] = []
     for model in dict.fromkeys(summary["model"]):
-        out += _model_claims(model, runs, regret, summary, check, members, cfg, seed, n_boot)
+        run = ExploratoryRun(
+            runs, regret, summary, check, model, budget, seed, int(cfg["bootstrap"])
+        )
+        ran = set(summary.loc[summary["model"] == model, "method"])
+        if mc and rqmc and {mc, rqmc} <= ran:
+            out.append(FR_1.build(run, rqmc, mc, margin_pp))
+        if sigma and {sigma, ref} <= ran:
+            out.append(FR_2.build(run, sigma, ref, margin_pp))
+        if mc and dpw and {mc, dpw} <= ran:
+            out.append(FR_3.build(run, dpw, mc, margin_m))
     return out
 
 
@@ -339,15 +388,24 @@ def frontier_claims(
 CONFIRM_TESTS = ("superiority", "non-inferiority")
 
 
+@dataclass(frozen=True)
+class PreregisteredRule(Rule):
+    """A rule fixed in a preregistration: its text ends with ``note`` (which one, by its
+    sha256), after the rule's own text."""
+
+    note: str = ""
+
+    def text(self) -> str:
+        """The rule's text, then its note."""
+        return f"{super().text()} {self.note}" if self.note else super().text()
+
+
 def confirm_rule(test: str, a: str, b: str, budget_ms: float, margin_m: float) -> Rule:
     """The rule of a preregistered FR claim: d = closed-loop mean location error of the tuned
     member ``a`` − that of ``b`` at ``budget_ms`` per step, paired over runs (95% t
     interval). ``superiority``: equivalent inside ±margin, supported below 0, not supported
     above 0; ``non-inferiority``: supported below +margin, not supported above it."""
-    basis = (
-        f"d = closed-loop mean location error, tuned {a} − {b} at {param_text(budget_ms)} ms "
-        "per step, paired over runs (m; 95% t interval)"
-    )
+    basis = WORDS("confirm_basis", a=a, b=b, budget=param_text(budget_ms))
     text = f"{param_text(margin_m)} m"
     if test == "superiority":
         return ci_side(KEY, 0.0, claimed="below", basis=basis, margin=margin_m, margin_text=text)
@@ -356,8 +414,150 @@ def confirm_rule(test: str, a: str, b: str, budget_ms: float, margin_m: float) -
     raise ValueError(f"test: {test!r} (allowed: {', '.join(CONFIRM_TESTS)})")
 
 
-def _label(families: Mapping[str, str], family: str) -> str:
-    return families.get(family, family)
+@dataclass(frozen=True, eq=False)
+class Comparison:
+    """One preregistered FR claim ``cid`` (``spec``: family, against, test, margin_m, why)
+    on ``model`` at the headline budget ``budget_ms``: the tuned configurations ``a`` (of
+    the family) and ``b`` (of the one it is compared against), their family labels, and the
+    preregistration's sha256 ``sha``."""
+
+    cid: str
+    model: str
+    spec: Mapping[str, Any]
+    budget_ms: float
+    a: Configuration
+    b: Configuration
+    labels: tuple[str, str]
+    sha: str
+
+    @property
+    def superiority(self) -> bool:
+        return self.spec["test"] == "superiority"
+
+    @property
+    def margin(self) -> float:
+        return float(self.spec["margin_m"])
+
+    def rule(self) -> PreregisteredRule:
+        """:func:`confirm_rule` with the preregistration's note."""
+        r = confirm_rule(self.spec["test"], *self.labels, self.budget_ms, self.margin)
+        note = WORDS("confirm_note", sha=self.sha[:12])
+        return PreregisteredRule(cases=r.cases, otherwise=r.otherwise, basis=r.basis, note=note)
+
+
+def _over_budget(c: Comparison, summary: pd.DataFrame) -> list[dict[str, Any]]:
+    """Each configuration over the budget, timed and in the closed loop: the tuning rule's
+    cost is the larger of the timed median and the closed loop's mean time per step."""
+    out = []
+    for cfg in (c.a, c.b):
+        r = summary.loc[(c.model, cfg.name)]
+        for kind, col in (("timed", "plan_ms"), ("loop", "loop_ms")):
+            if float(r[col]) > c.budget_ms:
+                out.append({"kind": kind, "label": cfg.label(), "ms": fmt(float(r[col]), 3)})
+    return out
+
+
+def _ladder_against(c: Comparison, lad: pd.DataFrame, verdict: str) -> list[dict[str, Any]]:
+    """The other budgets of the ladder whose CI lies where ``verdict`` says it does not:
+    better where the verdict is "not supported", worse where "supported", outside the margin
+    where "equivalent", off 0 either way where "inconclusive"."""
+    fam = c.spec["family"]
+    other = lad[
+        (lad["model"] == c.model) & (lad["family"] == fam) & (lad["budget_ms"] != c.budget_ms)
+    ]
+    bound = 0.0 if c.superiority else c.margin
+    out = []
+    for r in other.itertuples(index=False):
+        lo, hi = r.diff_mc_low, r.diff_mc_high
+        against = {
+            "equivalent": lo < -c.margin or hi > c.margin,
+            "supported": lo > bound,
+            "not supported": hi < bound,
+        }.get(verdict, hi < bound or lo > bound)
+        if against:
+            diff, ci = fmt(r.diff_mc, 3, True), fmt_ci(lo, hi, 3, True)
+            budget = param_text(r.budget_ms)
+            out.append(
+                {
+                    "kind": "ladder",
+                    "budget": budget,
+                    "better": r.diff_mc < 0,
+                    "diff": diff,
+                    "ci": ci,
+                }
+            )
+    return out
+
+
+def _depth(row: pd.Series) -> dict[str, str]:
+    """The tree search's depths: how far its plans follow its tree (``fr_confirm_measured``)."""
+    return {
+        "plan_depth": fmt(float(row["plan_depth"]), 3),
+        "max_depth": fmt(float(row["max_depth"]), 3),
+        "root_actions": fmt(float(row["root_actions"]), 3),
+        "depth1": fmt(100 * float(row["frac_depth1"]), 3),
+    }
+
+
+def confirm_evidence(
+    c: Comparison, runs: pd.DataFrame, summary: pd.DataFrame, lad: pd.DataFrame
+) -> Evidence:
+    """A preregistered FR claim on the confirmatory run: d = closed-loop mean location error
+    of ``c.a`` − ``c.b``, paired over runs (``runs``), with the probability of improvement;
+    the configurations' times (``summary`` indexed by model and config); the contrary
+    evidence of the budget and of the ladder ``lad``."""
+    d = paired_configs(runs, c.model, c.a.name, c.b.name)
+    rule = c.rule()
+    verdict = rule.verdict(paired_facts(d))
+    if c.superiority:
+        p = _p_side(d, verdict, c.margin)
+    else:
+        p = _p_noninferior(d, verdict, c.margin)
+    wide = runs[runs["model"] == c.model].pivot(index="run", columns="config", values="mean_error")
+    pi = prob_improvement(wide[c.a.name].to_numpy(), wide[c.b.name].to_numpy())
+    ra, rb = summary.loc[(c.model, c.a.name)], summary.loc[(c.model, c.b.name)]
+    family, against = c.labels
+    # a superiority rule's equivalence margin; a non-inferiority rule's margin is the null
+    key = KeyNumber(WORDS("confirm_key", family=family, against=against), float(d.mean),
+                    float(d.low), float(d.high), unit="m", reproducible="statistical", digits=3,
+                    null=0.0 if c.superiority else c.margin, p_value=p, n=_runs(d),
+                    margin=c.margin if c.superiority else None)  # fmt: skip
+    values = {
+        "cid": c.cid,
+        "model": c.model,
+        "budget": param_text(c.budget_ms),
+        "family": family,
+        "against": against,
+        "test": c.spec["test"],
+        "margin": param_text(c.margin),
+        "why": str(c.spec.get("why", "")),
+        "a": c.a.label(),
+        "b": c.b.label(),
+        "runs": d.n,
+        "error_a": fmt(float(ra["mean_error"])),
+        "error_b": fmt(float(rb["mean_error"])),
+        "improve": fmt(pi[0], 3),
+        "improve_ci": fmt_ci(pi[1], pi[2], 3),
+        "ms_a": fmt(float(ra["plan_ms"]), 3),
+        "work_a": fmt(float(ra["work_per_step"]), 3),
+        "ms_b": fmt(float(rb["plan_ms"]), 3),
+        "work_b": fmt(float(rb["work_per_step"]), 3),
+        "loop_a": fmt(float(ra["loop_ms"]), 3),
+        "loop_b": fmt(float(rb["loop_ms"]), 3),
+        "depth": _depth(ra) if c.a.family == "dpw" else None,
+        "contrary": _over_budget(c, summary) + _ladder_against(c, lad, verdict),
+    }
+    return Evidence(key=key, facts=paired_facts(d), values=values, rule=rule)
+
+
+FR_CONFIRM = ClaimSpec(
+    id="{cid}-{model}",
+    setup=WORDS("confirm_setup"),
+    evidence=confirm_evidence,
+    words=WORDS,
+    texts="fr_confirm",
+    part="beyond",
+)
 
 
 def confirm_claims(
@@ -377,124 +577,16 @@ def confirm_claims(
     sha256) in its rule; a member over the budget on this run's times, and a budget of the
     ladder where the difference lies on the other side, are contrary evidence. Claims whose
     families have no member at the headline budget are left out and said so."""
-    from rsmhp.studies.frontier.summarise import paired_configs, prob_improvement
-
     labels = {c.family: c.family_label for c in registry.families()}
     b = float(prereg["headline_budget_ms"])
-    out: list[Claim] = []
     s = summary.set_index(["model", "config"])
+    out: list[Claim] = []
     for model in prereg["models"]:
         per = chosen.get(model, {}).get(f"{b:g}", {})
-        wide = runs[runs["model"] == model].pivot(
-            index="run", columns="config", values="mean_error"
-        )
         for cid, spec in prereg["claims"].items():
             fam, ref = spec["family"], spec["against"]
-            if fam not in per or ref not in per:
-                continue
-            a_cfg, b_cfg = per[fam], per[ref]
-            d = paired_configs(runs, model, a_cfg.name, b_cfg.name)
-            margin = float(spec["margin_m"])
-            rule = confirm_rule(spec["test"], _label(labels, fam), _label(labels, ref), b, margin)
-            verdict = rule.verdict(paired_facts(d))
-            p = (
-                _p_side(d, verdict, margin)
-                if spec["test"] == "superiority"
-                else _p_noninferior(d, verdict, margin)
-            )
-            pi = prob_improvement(wide[a_cfg.name].to_numpy(), wide[b_cfg.name].to_numpy())
-            ra, rb = s.loc[(model, a_cfg.name)], s.loc[(model, b_cfg.name)]
-            contrary = []
-            for name, r in ((a_cfg.label(), ra), (b_cfg.label(), rb)):
-                # the tuning rule's cost: the larger of the timed median and the closed
-                # loop's own mean time per step
-                for what, col in (("timed", "plan_ms"), ("in closed loop", "loop_ms")):
-                    if float(r[col]) > b:
-                        contrary.append(
-                            f"{name} took {fmt(float(r[col]), 3)} ms per step {what}, over "
-                            "the budget"
-                        )
-            # the other budgets of the ladder whose CI lies where this verdict says it does
-            # not: better where the verdict is "not supported", worse where "supported",
-            # outside the margin where "equivalent", off 0 either way where "inconclusive"
-            other = lad[(lad["model"] == model) & (lad["family"] == fam) & (lad["budget_ms"] != b)]
-            bound = 0.0 if spec["test"] == "superiority" else margin
-            for r in other.itertuples(index=False):
-                lo_, hi_ = r.diff_mc_low, r.diff_mc_high
-                better, worse = hi_ < bound, lo_ > bound
-                if verdict == "equivalent":
-                    against = lo_ < -margin or hi_ > margin
-                elif verdict == "supported":
-                    against = lo_ > bound
-                elif verdict == "not supported":
-                    against = hi_ < bound
-                else:
-                    against = better or worse
-                if against:
-                    how = "better" if r.diff_mc < 0 else "worse"
-                    contrary.append(
-                        f"at {param_text(r.budget_ms)} ms it tracks {how}: "
-                        f"{fmt(r.diff_mc, 3, True)} m {fmt_ci(lo_, hi_, 3, True)}"
-                    )
-            depth = ""
-            if a_cfg.family == "dpw":
-                depth = (
-                    f"; the tree search's plans follow its tree for "
-                    f"{fmt(float(ra['plan_depth']), 3)} of H steps on average (deepest node "
-                    f"{fmt(float(ra['max_depth']), 3)}, {fmt(float(ra['root_actions']), 3)} root "
-                    f"actions, {fmt(100 * float(ra['frac_depth1']), 3)}% of simulations leave "
-                    "the tree at depth 1)"
-                )
-            claim_text = (
-                f"On '{model}', at {param_text(b)} ms of planning per step, the tuned "
-                f"{_label(labels, fam)} member "
-                + (
-                    f"tracks better than the tuned {_label(labels, ref)} member (lower "
-                    "closed-loop error)"
-                    if spec["test"] == "superiority"
-                    else f"tracks as well as the tuned {_label(labels, ref)} member, up to "
-                    f"{param_text(margin)} m of closed-loop error"
-                )
-            )
-            out.append(
-                Claim(
-                    f"{cid}-{model}",
-                    claim_text,
-                    "Beyond the paper (its UAV study compares NBO, RS-MHP and pruning only): "
-                    + str(spec.get("why", "")),
-                    KeyNumber(
-                        f"error, tuned {_label(labels, fam)} − {_label(labels, ref)}, paired mean",
-                        float(d.mean),
-                        float(d.low),
-                        float(d.high),
-                        unit="m",
-                        reproducible="statistical",
-                        digits=3,
-                        null=0.0 if spec["test"] == "superiority" else margin,
-                        p_value=p,
-                        n=_runs(d),
-                        # a superiority rule's equivalence margin; a non-inferiority rule's
-                        # margin is the null
-                        margin=margin if spec["test"] == "superiority" else None,
-                    ),
-                    verdict,
-                    rule.text() + f" (preregistered, sha256 {prereg_sha[:12]})",
-                    measured=(
-                        f"{a_cfg.label()} against {b_cfg.label()}: "
-                        f"{d.n} paired runs on the confirmatory stream; mean error "
-                        f"{fmt(float(ra['mean_error']))} vs {fmt(float(rb['mean_error']))} m; "
-                        f"probability of improvement {fmt(pi[0], 3)} "
-                        f"{fmt_ci(pi[1], pi[2], 3)}; {a_cfg.label()} "
-                        f"{fmt(float(ra['plan_ms']), 3)} ms and "
-                        f"{fmt(float(ra['work_per_step']), 3)} model steps per step, "
-                        f"{b_cfg.label()} {fmt(float(rb['plan_ms']), 3)} ms and "
-                        f"{fmt(float(rb['work_per_step']), 3)} model steps (interleaved timing, "
-                        f"median); in closed loop {fmt(float(ra['loop_ms']), 3)} and "
-                        f"{fmt(float(rb['loop_ms']), 3)} ms per step (mean over runs){depth}"
-                    ),
-                    part="beyond",
-                    setup=f"UAV '{model}', confirmatory stream, {param_text(b)} ms per step",
-                    contrary="; ".join(contrary),
-                )
-            )
+            if fam in per and ref in per:
+                pair = (labels.get(fam, fam), labels.get(ref, ref))
+                c = Comparison(cid, model, spec, b, per[fam], per[ref], pair, prereg_sha)
+                out.append(FR_CONFIRM.build(c, runs, s, lad))
     return out
