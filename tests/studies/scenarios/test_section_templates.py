@@ -115,3 +115,10 @@ def test_a_missing_value_is_an_error(rendered):
     group = {"group": "g", "scenarios": 2, "methods": 2, "lowest": None}  # no "highest"
     with pytest.raises(jinja2.UndefinedError, match="highest"):
         render(PACKAGE, "section.md", best=[], empty=False, groups=[group])
+
+
+@pytest.mark.parametrize("template", sorted(p.name for p in HERE.glob("*.md")))
+def test_template_lines_are_wrapped(template):
+    """Long lines are continued with a backslash, so a diff shows the sentence that changed."""
+    source = (HERE / template).read_text(encoding="utf-8")
+    assert [line for line in source.split("\n") if len(line) > 100] == []

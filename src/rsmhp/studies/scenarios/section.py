@@ -168,20 +168,32 @@ def _group_text(summary: pd.DataFrame, group: str) -> GroupText:
 
 
 @dataclass(frozen=True)
+class Count:
+    """How many cells (``n``) a family (``label``) is the clear best in."""
+
+    label: str
+    n: int
+
+
+@dataclass(frozen=True)
 class BestText:
-    """What the main text says of one group of the best-method grid: its cells and runs per
-    cell, how many have a clear best and the families of those (``label in count``, most
-    frequent first), how many are tied and the range of tied methods there, and the family
-    that is best in the most cells (every one of them on a tie, with the count)."""
+    """What the main text says of one group of the best-method grid: its cells and the
+    smallest and largest runs per cell, how many have a clear best and the families of those
+    (``clear_best``, most frequent first), how many are tied and the smallest and largest
+    number of methods tied with the best there (0 without a tie), and the families that are
+    best in the most cells (``top``, every one of them on a tie, each best in ``top_n``)."""
 
     name: str
     cells: int
-    runs: str
+    runs_min: int
+    runs_max: int
     clear: int
-    clear_best: str
+    clear_best: list[Count]
     tied: int
-    tie_range: str
-    top: str
+    tie_min: int
+    tie_max: int
+    top: list[str]
+    top_n: int
 
 
 def _counts(labels: list[str]) -> list[tuple[str, int]]:
@@ -207,22 +219,18 @@ def _best_text(best: pd.DataFrame, group: str) -> BestText:
     winners = [lab for lab, c in zip(labels, clear, strict=True) if c]
     counts = _counts(labels)
     top_n = counts[0][1]
-    top = [lab for lab, n in counts if n == top_n]  # every family at the highest count
-    if not tied:
-        tie_range = ""
-    elif min(tied) == max(tied):
-        tie_range = f"{min(tied)} other method{'s' if min(tied) > 1 else ''}"
-    else:
-        tie_range = f"{min(tied)} to {max(tied)} other methods"
     return BestText(
         name=GROUP_NAMES.get(group, group),
         cells=len(g),
-        runs=str(runs[0]) if len(runs) == 1 else f"{runs[0]} to {runs[-1]}",
+        runs_min=runs[0],
+        runs_max=runs[-1],
         clear=int(clear.sum()),
-        clear_best=", ".join(f"{lab} in {n}" for lab, n in _counts(winners)),
+        clear_best=[Count(lab, n) for lab, n in _counts(winners)],
         tied=len(tied),
-        tie_range=tie_range,
-        top=" and ".join(top) + f" ({top_n} of {len(g)}{' each' if len(top) > 1 else ''})",
+        tie_min=min(tied, default=0),
+        tie_max=max(tied, default=0),
+        top=[lab for lab, n in counts if n == top_n],  # every family at the highest count
+        top_n=top_n,
     )
 
 
