@@ -135,3 +135,19 @@ def test_a_missing_field_is_an_error():
               "comparisons": [{"claims": "FR-1", "results": []}]}  # fmt: skip
     with pytest.raises(jinja2.UndefinedError, match="compared"):
         render(PACKAGE, "section.md", **values)
+
+
+def test_every_macro_of_the_claims_template_is_used():
+    """The claims' words (``claims.md``, :data:`rsmhp.studies.frontier.claims.WORDS`) hold no
+    macro that neither the claims module nor one of its specs nor another macro uses."""
+    from tests.studies.uav.test_uav_claims import unused_macros
+
+    assert claims.WORDS.package == PACKAGE
+    assert unused_macros(claims) == set()
+
+
+@pytest.mark.parametrize("template", sorted(p.name for p in HERE.glob("*.md")))
+def test_template_lines_are_wrapped(template):
+    """Long lines are continued with a backslash, so a diff shows the sentence that changed."""
+    source = (HERE / template).read_text(encoding="utf-8")
+    assert [line for line in source.split("\n") if len(line) > 100] == []

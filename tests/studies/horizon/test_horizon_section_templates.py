@@ -301,3 +301,19 @@ def test_every_template_beside_the_code_is_rendered():
         "section_optimiser.md",
         "section_optimiser_appendix.md",
     }
+
+
+def test_every_macro_of_the_claims_template_is_used():
+    """The claims' words (``claims.md``, :data:`rsmhp.studies.horizon.claims.WORDS`) hold no
+    macro that neither the claims module nor one of its specs nor another macro uses."""
+    from tests.studies.uav.test_uav_claims import unused_macros
+
+    assert claims.WORDS.package == PACKAGE
+    assert unused_macros(claims) == set()
+
+
+@pytest.mark.parametrize("template", sorted(p.name for p in HERE.glob("*.md")))
+def test_template_lines_are_wrapped(template):
+    """Long lines are continued with a backslash, so a diff shows the sentence that changed."""
+    source = (HERE / template).read_text(encoding="utf-8")
+    assert [line for line in source.split("\n") if len(line) > 100] == []
