@@ -27,6 +27,7 @@ from rsmhp.pipeline.config import ConfigError, check_config
 from rsmhp.pipeline.contracts import read_checked
 from rsmhp.report.figures import save_figure
 from rsmhp.report.markdown import fmt, range_text
+from rsmhp.studies.horizon.checks import optimiser_problems as config_problems
 from rsmhp.studies.horizon.chunks import units
 from rsmhp.studies.horizon.claims import _hz3, budget_text
 from rsmhp.studies.horizon.figures_optimiser import budget_label, largest_budget, optimiser_figure
@@ -44,7 +45,6 @@ from rsmhp.studies.horizon.section_optimiser import (
 from rsmhp.studies.horizon.simulate_optimiser import (
     RULE,
     SPLIT_COLUMNS,
-    config_problems,
     split_contract,
 )
 from rsmhp.studies.horizon.summarise_optimiser import summarize_split
