@@ -303,20 +303,9 @@ def evidence_est1(s: pd.DataFrame) -> Evidence:
     problems left out of the slope evidence with why."""
     sl = tree_slopes(s)
     counted = sl[sl["counted"]]
-    if len(counted):
-        worst = counted.loc[counted["slope_high"].idxmax()]
-        key = KeyNumber(
-            name=WORDS("est_1_key", problem=worst["problem"]),
-            value=float(worst["slope"]),
-            ci_low=float(worst["slope_low"]),
-            ci_high=float(worst["slope_high"]),
-            null=0.0,
-        )
-    else:
-        key = KeyNumber(name=WORDS("est_1_key_none", sizes=MIN_TREE_SIZES), value=0.0)
     covered, cells = tree_coverage(s)
     return Evidence(
-        key=key,
+        key=_key_est1(counted),
         facts=facts_est1(s),
         values={
             "slopes": [
@@ -339,6 +328,21 @@ def evidence_est1(s: pd.DataFrame) -> Evidence:
             ],
             "problems": [_dropped_est1(r) for _, r in sl[~sl["counted"]].iterrows()],
         },
+    )
+
+
+def _key_est1(counted: pd.DataFrame) -> KeyNumber:
+    """The counted slope whose CI reaches highest (null 0), or the count 0 of counted
+    problems."""
+    if not len(counted):
+        return KeyNumber(name=WORDS("est_1_key_none", sizes=MIN_TREE_SIZES), value=0.0)
+    worst = counted.loc[counted["slope_high"].idxmax()]
+    return KeyNumber(
+        name=WORDS("est_1_key", problem=worst["problem"]),
+        value=float(worst["slope"]),
+        ci_low=float(worst["slope_low"]),
+        ci_high=float(worst["slope_high"]),
+        null=0.0,
     )
 
 
@@ -506,21 +510,10 @@ def evidence_est4(s: pd.DataFrame) -> Evidence:
     would have, N^H, against the M kept, and the largest gap to the weighted pruned cells."""
     top = pruning_at_largest_n(s)
     near = top.loc[top["bias_fraction_low"].idxmin()] if len(top) else None
-    if near is not None:
-        key = KeyNumber(
-            name=WORDS("est_4_key", problem=near["problem"], N=int(near["N"]), M=int(near["M"])),
-            value=float(near["bias_fraction_of_nbo"]),
-            ci_low=float(near["bias_fraction_low"]),
-            ci_high=float(near["bias_fraction_high"]),
-            digits=4,
-            null=0.0,
-        )
-    else:
-        key = KeyNumber(name=WORDS("est_4_key_none"), value=0.0)
     gap = pruning_weighting_gap(s)
     by_problem = top.groupby("problem", sort=False)
     return Evidence(
-        key=key,
+        key=_key_est4(near),
         facts=facts_est4(top),
         values={
             "sizes": sizes_text(sorted(top["N"].unique())),
@@ -537,19 +530,36 @@ def evidence_est4(s: pd.DataFrame) -> Evidence:
                 "f": fmt(near["bias_fraction_of_nbo"], 3),
                 "ci": fmt_ci(near["bias_fraction_low"], near["bias_fraction_high"]),
             },
-            "compute": [
-                {
-                    "problem": p,
-                    "N": int(g["N"].iloc[0]),
-                    "M": int(g["M"].max()),
-                    "leaves": f"{float(g['N'].iloc[0]) ** int(g['H'].iloc[0]):.3g}",
-                }
-                for p, g in by_problem
-                if "H" in top.columns
-            ],
+            "compute": [_compute_est4(p, g) for p, g in by_problem if "H" in top.columns],
             "gap": None if gap is None else fmt(gap, 2),
         },
     )
+
+
+def _key_est4(near: pd.Series | None) -> KeyNumber:
+    """The fraction of the pruned cell ``near`` whose CI reaches nearest to J (null 0, 4
+    digits), or the count 0 of pruned cells."""
+    if near is None:
+        return KeyNumber(name=WORDS("est_4_key_none"), value=0.0)
+    return KeyNumber(
+        name=WORDS("est_4_key", problem=near["problem"], N=int(near["N"]), M=int(near["M"])),
+        value=float(near["bias_fraction_of_nbo"]),
+        ci_low=float(near["bias_fraction_low"]),
+        ci_high=float(near["bias_fraction_high"]),
+        digits=4,
+        null=0.0,
+    )
+
+
+def _compute_est4(problem: Any, g: pd.DataFrame) -> dict[str, Any]:
+    """A problem's pruned cells at the largest N: the most trajectories kept, M, against the
+    full tree's N^H leaves (3 significant digits)."""
+    return {
+        "problem": problem,
+        "N": int(g["N"].iloc[0]),
+        "M": int(g["M"].max()),
+        "leaves": f"{float(g['N'].iloc[0]) ** int(g['H'].iloc[0]):.3g}",
+    }
 
 
 EST_4 = ClaimSpec(id="EST-4", setup=SETUP, evidence=evidence_est4, words=WORDS, rule=RULE_EST4)
