@@ -23,7 +23,10 @@ and, for a family of an installed plugin (:func:`rsmhp.models.uav.methods.plugin
 member (a plugin changes no run it is not configured in); ``colour_key`` a key of
 :data:`rsmhp.report.palette.METHOD_COLOURS` or a hex colour ``#rrggbb`` (a family the palette
 does not know); ``order`` an int; ``baseline``, ``uses_rng``, ``estimates_cost`` bools; the
-class registered, and exactly one baseline family.
+class registered, and exactly one baseline family. ``config_key`` and ``colour_key`` default to
+the family's id where the family does not set them (``Method.derived_attributes`` lists
+which), so a new family whose id the palette does not know fails ``[colour_key]`` until it
+sets a colour.
 
 Members (``[config]``, ``[names]``, ``[round trip]``, ``[spec]``, ``[columns]``,
 ``[job_key]``, ``[presentation]``, ``[registry config]``, ``[config schema]``): the config
@@ -388,7 +391,12 @@ def _check_class(c: _Checker, cls: type[Method]) -> None:
             isinstance(key, str) and (key in palette.METHOD_COLOURS or _HEX.fullmatch(key)),
             "colour_key",
             f"{key!r} is neither a key of rsmhp.report.palette.METHOD_COLOURS "
-            f"(allowed: {sorted(palette.METHOD_COLOURS)}) nor a hex colour '#rrggbb'",
+            f"(allowed: {sorted(palette.METHOD_COLOURS)}) nor a hex colour '#rrggbb'"
+            + (
+                "; it defaults to the family id: set colour_key to a hex colour"
+                if "colour_key" in getattr(cls, "derived_attributes", ())
+                else ""
+            ),
         )
     with c.step("registry"):
         fams = registry.families()
