@@ -1,6 +1,7 @@
 # The two commands of the README:
 #   make replicate   set up .venv if needed, then run the full replication (snakemake -j2)
 #   make test        set up .venv if needed, then lint and run the test suite
+# (make test-fast: the quick tier, no lint and no test marked workflow, slurm or compile)
 # Set-up needs only Python >= 3.11 with pip and venv, and access to PyPI.
 
 PYTHON ?= python3
@@ -21,7 +22,7 @@ $(error EMULATE=$(EMULATE): the only emulation is avx2 (or leave EMULATE unset))
 endif
 STAMP := $(VENV)/.rsmhp-installed
 
-.PHONY: help replicate tune publish verify portability compare test lint setup clean
+.PHONY: help replicate tune publish verify portability compare test test-fast lint setup clean
 
 help:
 	@echo "rsmhp: replication pipeline (RS-MHP vs NBO). Targets:"
@@ -34,6 +35,7 @@ help:
 	@echo "                             numpy SIMD) elsewhere; compare with results/ and paper/claims.json"
 	@echo "  make publish               update the tracked paper/ and README results from results/paper/"
 	@echo "  make test                  set up, lint, run the test suite (what CI runs)"
+	@echo "  make test-fast             the quick tier: no lint, no test marked workflow, slurm or compile"
 	@echo "  make setup                 create .venv, install rsmhp[dev], compile every numba kernel (in parallel)"
 	@echo "  make lint                  ruff, ruff format --check, snakefmt --check, snakemake --lint"
 	@echo "  make clean                 delete results/ and .snakemake/"
@@ -121,6 +123,13 @@ $(PLUGIN_STAMP): $(STAMP) $(PLUGIN)/pyproject.toml
 
 test: lint $(PLUGIN_STAMP)
 	$(BIN)/python -m pytest --durations=25 tests $(PLUGIN)/tests
+
+# the quick tier (tests/conftest.py): every test but those that run the workflow for real
+# (workflow), on the local SLURM cluster (slurm) or compile numba kernels cold or for another
+# CPU (compile); no lint. make test runs them all.
+FAST := not workflow and not slurm and not compile
+test-fast: $(PLUGIN_STAMP)
+	$(BIN)/python -m pytest --durations=10 -m "$(FAST)" tests $(PLUGIN)/tests
 
 clean:
 	rm -rf results .snakemake

@@ -1,7 +1,30 @@
-"""Shared fixtures: the paper's LQG setting and helpers."""
+"""Shared fixtures (the paper's LQG setting, the session's tiny workflow runs) and the test tiers.
+
+Tiers: three markers (registered in pyproject.toml) set apart what is slow; ``make test-fast``
+runs every test that carries none of them, ``make test`` (CI) runs everything.
+
+* ``workflow``: the test runs the Snakemake workflow for real, i.e. snakemake executes jobs (a
+  whole run, named targets, a rerun on a copy of a run, the portability drill), or it uses a
+  session fixture that does (:data:`WORKFLOW_FIXTURES`, marked here, for every test that uses
+  one). A dry run (``-n``), ``--lint``, a rule listing or graph, ``--unlock`` or ``--report``
+  executes no job: a test that only does those is not ``workflow``.
+* ``slurm``: the test runs on a local SLURM cluster (tests/pipeline/test_slurm_cluster.py).
+* ``compile``: the test compiles numba kernels cold in a fresh process (an empty cache) or for
+  an emulated CPU.
+
+An unmarked test that starts a real workflow run (or the SLURM cluster) fails, naming the
+marker it lacks (:func:`real_run`, checked around every test's set-up and call), so the fast
+tier never runs one unnoticed.
+"""
 
 from __future__ import annotations
 
+import contextlib
+import os
+import re
+import shlex
+import subprocess
+from collections.abc import Iterator
 from pathlib import Path
 
 import numpy as np
@@ -11,6 +34,101 @@ from rsmhp.models.lqg.oven import LQGModel
 
 PAPER = {"x0": 0.0, "a": 0.5, "r": 10.0, "target": 1.0, "sigma": 1.0}
 PAPER_U = np.array([0.55, 0.17])
+
+ROOT = Path(__file__).resolve().parents[1]
+
+# ----------------------------------------------------------------------------------- tiers
+
+#: session fixtures that run the workflow: every test using one is marked ``workflow``
+WORKFLOW_FIXTURES = frozenset({"run_j2", "run_j1"})
+#: test files marked ``compile`` here (the files of the tiers' own modules carry pytestmark)
+COMPILE_FILES = frozenset({"tests/models/uav/test_compile.py"})
+#: snakemake options with which it executes no job
+NO_JOBS = frozenset(
+    {
+        "-n", "--dry-run", "--dryrun", "--lint", "-l", "--list", "--list-rules",
+        "--list-target-rules", "--lt", "--rulegraph", "--dag", "--filegraph", "--d3dag",
+        "-S", "--summary", "-D", "--detailed-summary", "--unlock", "--report", "--version",
+        "-v", "-h", "--help", "--list-changes", "--lc", "--cleanup-metadata", "--cm",
+    }
+)  # fmt: skip
+#: the markers that allow a real run of each kind
+ALLOWED = {"workflow": {"workflow", "slurm"}, "slurm": {"slurm"}}
+
+
+def real_run(args) -> str | None:
+    """The kind of real run the command ``args`` (as given to :class:`subprocess.Popen`)
+    starts: ``"workflow"`` (snakemake executing jobs, or the portability drill), ``"slurm"``
+    (scripts/slurm-local.sh, the local cluster), else None."""
+    if isinstance(args, str | bytes):
+        words = shlex.split(os.fsdecode(args))
+    elif isinstance(args, os.PathLike):
+        words = [os.fsdecode(args)]
+    else:
+        words = [os.fsdecode(a) for a in args]
+    names = [Path(w).name for w in words]
+    if "slurm-local.sh" in names:
+        return "slurm"
+    module = words[words.index("-m") + 1] if "-m" in words[:-1] else None
+    help_only = {"-h", "--help"} & set(words)
+    if module == "rsmhp.report.portability":
+        return None if help_only else "workflow"
+    if module != "snakemake" and "snakemake" not in names[:2]:
+        return None
+    if NO_JOBS & set(words) or any(re.fullmatch(r"-[a-zA-Z]*n[a-zA-Z]*", w) for w in words):
+        return None  # -n, or short flags bundled with it (-np)
+    return "workflow"
+
+
+@contextlib.contextmanager
+def _guarded(item: pytest.Item) -> Iterator[None]:
+    """While ``item`` sets up or runs: starting a real run its markers do not allow fails it."""
+    marks = {m.name for m in item.iter_markers()}
+    original = subprocess.Popen
+
+    class Guarded(original):  # type: ignore[misc, valid-type]
+        def __init__(self, args, *a, **kw):
+            kind = real_run(args)
+            if kind and not ALLOWED[kind] & marks:
+                one = isinstance(args, str | bytes | os.PathLike)
+                command = os.fsdecode(args) if one else " ".join(map(os.fsdecode, args))
+                pytest.fail(
+                    f"{item.nodeid} starts a real {kind} run without its marker: add "
+                    f"@pytest.mark.{kind} (tests/conftest.py, the test tiers): {command[:300]}",
+                    pytrace=False,
+                )
+            super().__init__(args, *a, **kw)
+
+    subprocess.Popen = Guarded
+    try:
+        yield
+    finally:
+        subprocess.Popen = original
+
+
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    for item in items:
+        if WORKFLOW_FIXTURES & set(getattr(item, "fixturenames", ())):
+            item.add_marker(pytest.mark.workflow)
+        if item.path.is_relative_to(ROOT) and (
+            item.path.relative_to(ROOT).as_posix() in COMPILE_FILES
+        ):
+            item.add_marker(pytest.mark.compile)
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_setup(item: pytest.Item):
+    with _guarded(item):
+        return (yield)
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_call(item: pytest.Item):
+    with _guarded(item):
+        return (yield)
+
+
+# -------------------------------------------------------------------------------- fixtures
 
 
 @pytest.fixture
@@ -32,6 +150,34 @@ def run_j2(tmp_path_factory) -> Path:
     res = snakemake(wd, "-j2")
     assert res.returncode == 0, res.stderr[-3000:]
     return wd
+
+
+#: the targets of the session's -j1 run (what the -j1 against -j2 comparisons read)
+J1_TARGETS = ("lqg", "estimators", "results/decisions/lqg_regret.csv", "uav_collect")
+
+
+@pytest.fixture(scope="session")
+def run_j1(tmp_path_factory) -> Path:
+    """The tiny config's LQG, estimator, LQG-decision and UAV simulations with -j1 (one worker),
+    from an empty directory, once per session: compared with ``run_j2``."""
+    from tests.pipeline.test_workflow import snakemake
+
+    wd = tmp_path_factory.mktemp("wf_j1")
+    res = snakemake(wd, "-j1", *J1_TARGETS)
+    assert res.returncode == 0, res.stderr[-3000:]
+    return wd
+
+
+@pytest.fixture(scope="session")
+def tiny_dry_run(tmp_path_factory) -> str:
+    """``snakemake -n`` of the tiny config's default target from an empty directory (its
+    output): the job layout the dry-run tests check (no job runs)."""
+    from tests.pipeline.test_workflow import snakemake
+
+    res = snakemake(tmp_path_factory.mktemp("dry"), "-n")
+    out = res.stdout + res.stderr
+    assert res.returncode == 0, out[-3000:]
+    return out
 
 
 @pytest.fixture(scope="session")

@@ -7,6 +7,8 @@ import sys
 import textwrap
 from pathlib import Path
 
+import pytest
+
 from rsmhp.core import numba_cache
 
 DEP = "from numba import njit\n\n@njit(inline='always')\ndef k():\n    return {value}\n"
@@ -39,6 +41,7 @@ def _run(tmp: Path) -> str:
     return out.stdout.strip()
 
 
+@pytest.mark.compile
 def test_an_edit_of_an_inlined_module_recompiles_the_cached_caller(tmp_path):
     """Without the stamp numba would load the cached run() and print the old value."""
     (tmp_path / "dep.py").write_text(DEP.format(value=1))

@@ -37,6 +37,7 @@ def test_every_kernel_module_is_warmed():
     assert len(set(entries)) == len(entries), "an entry is in two tasks"
 
 
+@pytest.mark.compile
 def test_warm_reports_every_module_and_a_warm_process_compiles_nothing():
     wall, per = warm.warm(2)
     assert [m for m, _ in per] == [m for task in warm.TASKS for m in task]

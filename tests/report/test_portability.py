@@ -292,6 +292,7 @@ def _content(path: Path, aside: list[str]) -> str:
 
 
 @pytest.mark.workflow
+@pytest.mark.compile  # every kernel compiled for the generic CPU in the emulated run
 def test_drill_on_the_tiny_config(run_j2, tmp_path):
     """The emulated tiny run: numba compiled every kernel for the generic CPU, OpenBLAS ran on
     another core type (both recorded inside the run), every verdict is the native run's, the

@@ -50,10 +50,13 @@ H = 6
 #: remainder after the vector loop)
 LAYOUTS = {"scalar": 7, "soa": 37}
 
-pytestmark = pytest.mark.skipif(
-    platform.machine().lower() not in ("x86_64", "amd64"),
-    reason="emulates an x86-64 CPU (LLVM znver3)",
-)
+pytestmark = [
+    pytest.mark.compile,  # the subprocess compiles for the emulated CPU (cold: about a minute)
+    pytest.mark.skipif(
+        platform.machine().lower() not in ("x86_64", "amd64"),
+        reason="emulates an x86-64 CPU (LLVM znver3)",
+    ),
+]
 
 
 def _sensors() -> dict[str, SensorModel]:

@@ -1,0 +1,98 @@
+"""The test tiers (tests/conftest.py): which commands are real workflow runs, the guard that
+fails an unmarked test starting one, and the markers that select the tiers."""
+
+from __future__ import annotations
+
+import re
+import sys
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from tests import conftest
+
+ROOT = Path(__file__).resolve().parents[2]
+PY = sys.executable
+
+
+@pytest.mark.parametrize(
+    ("args", "kind"),
+    [
+        ([PY, "-m", "snakemake", "-s", "Snakefile", "-d", "wd", "-j2"], "workflow"),
+        ([PY, "-m", "snakemake", "-j1", "verify"], "workflow"),
+        ([PY, "-m", "snakemake", "--unlock"], None),
+        ([PY, "-m", "snakemake", "-n", "--profile", "workflow/profiles/slurm"], None),
+        ([PY, "-m", "snakemake", "-np", "all"], None),
+        ([PY, "-m", "snakemake", "--dry-run"], None),
+        ([PY, "-m", "snakemake", "--lint"], None),
+        ([PY, "-m", "snakemake", "--list-rules"], None),
+        ([PY, "-m", "snakemake", "--rulegraph"], None),
+        ([PY, "-m", "snakemake", "--report", "report.html"], None),
+        ([".venv/bin/snakemake", "-j2", "report"], "workflow"),
+        ("snakemake -j2 --forceall", "workflow"),
+        ([PY, ".venv/bin/snakemake", "-j1", "tune"], "workflow"),
+        ([PY, "-m", "rsmhp.report.portability", "--native", "x", "--no-native-run"], "workflow"),
+        ([PY, "-m", "rsmhp.report.portability", "--help"], None),
+        (["bash", "scripts/slurm-local.sh", "up"], "slurm"),
+        ([PY, "-m", "rsmhp.pipeline.warm", "--cores", "2"], None),
+        ([PY, "-c", "import snakemake"], None),
+        (["git", "rev-parse", "HEAD"], None),
+        ([Path(PY), "-m", "snakemake", b"-j2"], "workflow"),
+    ],
+)
+def test_real_runs_are_told_from_dry_runs(args, kind):
+    assert conftest.real_run(args) == kind
+
+
+def _fake_snakemake(tmp_path: Path) -> Path:
+    """An executable named snakemake that only records that it ran."""
+    fake = tmp_path / "snakemake"
+    fake.write_text('#!/bin/sh\ntouch "$0.ran"\n')
+    fake.chmod(0o755)
+    return fake
+
+
+def test_an_unmarked_test_cannot_start_a_real_run(request, tmp_path):
+    """This test carries no tier marker: inside the guard a real run fails it before any
+    process starts, naming the marker; a dry run starts."""
+    import subprocess
+
+    fake = _fake_snakemake(tmp_path)
+    ran = tmp_path / "snakemake.ran"
+    before = subprocess.Popen
+    with conftest._guarded(request.node):
+        with pytest.raises(pytest.fail.Exception, match=r"add @pytest.mark.workflow"):
+            subprocess.run([str(fake), "-j1", "all"], check=True)
+        assert not ran.exists()
+        subprocess.run([str(fake), "-n", "all"], check=True)
+        assert ran.exists()
+    assert subprocess.Popen is before  # restored
+
+
+@pytest.mark.workflow
+def test_a_workflow_test_may_start_one(request, tmp_path):
+    """The marker lets the run through (the fake runs instead of the workflow: no cost)."""
+    import subprocess
+
+    fake = _fake_snakemake(tmp_path)
+    with conftest._guarded(request.node):
+        subprocess.run([str(fake), "-j1", "all"], check=True)
+    assert (tmp_path / "snakemake.ran").exists()
+
+
+def test_the_tiers_name_registered_markers_and_the_fixtures_mark_their_tests(request):
+    """make test-fast deselects exactly the three registered tier markers; every collected test
+    that uses a workflow fixture is marked workflow, every test of a compile file compile."""
+    ini = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["pytest"]["ini_options"]
+    registered = {m.split(":", 1)[0] for m in ini["markers"]}
+    assert "--strict-markers" in ini["addopts"].split()
+    fast = re.search(r"^FAST := (.*)$", (ROOT / "Makefile").read_text(), flags=re.M).group(1)
+    assert fast == "not workflow and not slurm and not compile"
+    assert set(re.findall(r"not (\w+)", fast)) == {"workflow", "slurm", "compile"} <= registered
+    for item in request.session.items:
+        marks = {m.name for m in item.iter_markers()}
+        if conftest.WORKFLOW_FIXTURES & set(getattr(item, "fixturenames", ())):
+            assert "workflow" in marks, item.nodeid
+        if item.nodeid.split("::")[0] in conftest.COMPILE_FILES:
+            assert "compile" in marks, item.nodeid
