@@ -175,7 +175,7 @@ def _intermediates(cfg: dict) -> dict[str, tuple[str, Contract]]:
         ),
         "uav_regret": (
             "results/decisions/uav_regret.csv",
-            decisions_uav.regret_contract(dec["uav"]),
+            decisions_uav.regret_contract({**dec["uav"], "models": cfg["uav_models"]}),
         ),
         "map_runs": (f"results/decisions/map/{cell}.csv", map_runs),
         "map_regret": (f"results/decisions/map/{cell}_regret.csv", map_regret),

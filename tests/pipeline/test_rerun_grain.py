@@ -16,7 +16,7 @@ import subprocess
 import sys
 from pathlib import Path
 
-from tests.pipeline.test_workflow import ROOT, TINY, copy_workflow_and_run
+from tests.pipeline.test_workflow import COPY_TRIGGERS, ROOT, TINY, copy_workflow_and_run
 
 # every rule that simulates or times planners (what a presentation edit must never rerun)
 SIMULATIONS = {
@@ -47,7 +47,7 @@ def _jobs(wf: Path, run: Path, *configfiles: Path) -> list[tuple[str, str]]:
     on the path (its registry parses the config)."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(wf / "src"), str(ROOT)])}
     cmd = [sys.executable, "-m", "snakemake", "-s", str(wf / "Snakefile"), "-d", str(run)]
-    cmd += ["-n", "--configfile", str(TINY), *map(str, configfiles)]
+    cmd += ["-n", *COPY_TRIGGERS, "--configfile", str(TINY), *map(str, configfiles)]
     res = subprocess.run(cmd, capture_output=True, text=True, timeout=600, env=env)
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-3000:]

@@ -66,7 +66,11 @@ def test_dry_run_has_the_configured_jobs(tmp_path):
     est = cfg["estimators"]
     want = {
         "estimators_ablation": len(ablation_chunks(est, cfg["lqg"]["model"], 2)),
-        "decisions_uav": len(chunk_jobs(cfg["decisions"]["uav"], split["decisions_uav"])),
+        "decisions_uav": len(
+            chunk_jobs(
+                {**cfg["decisions"]["uav"], "models": cfg["uav_models"]}, split["decisions_uav"]
+            )
+        ),
         "frontier_confirm": len(confirm_chunks(3, split["frontier_confirm"])),  # 3 runs, fp150
         "horizon_uav": sum(
             j for *_, j in units(hz["models"], hz["H"], split["horizon_uav"], hz["runs"])

@@ -696,10 +696,17 @@ def copy_workflow_and_run(run_j2: Path, tmp_path: Path) -> tuple[Path, Path]:
     return wf, run
 
 
+#: what reruns a job in a copy made by copy_workflow_and_run: every trigger but the set of
+#: input files, which differs for the rules that read this checkout's published files by
+#: absolute path (paper/exploratory, paper/superseded under the workflow's directory: the
+#: copy's, not the run's) though no content changed
+COPY_TRIGGERS = ("--rerun-triggers", "mtime", "params", "software-env", "code")
+
+
 def _dry_run(wf: Path, run: Path) -> tuple[set[str], set[str]]:
     """(every rule `snakemake -n` schedules, the rules among them whose reason is a params
     change), target rules aside."""
-    res = snakemake(run, "-n", snakefile=wf / "Snakefile")
+    res = snakemake(run, "-n", *COPY_TRIGGERS, snakefile=wf / "Snakefile")
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-3000:]
     if "Nothing to be done" in out:
