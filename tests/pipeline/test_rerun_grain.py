@@ -16,7 +16,12 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 from tests.pipeline.test_workflow import COPY_TRIGGERS, ROOT, TINY, copy_workflow_and_run
+
+#: reads (a copy of) the session's tiny run; its own snakemake calls are dry runs
+pytestmark = pytest.mark.workflow
 
 # every rule that simulates or times planners (what a presentation edit must never rerun)
 SIMULATIONS = {

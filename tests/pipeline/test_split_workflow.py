@@ -25,8 +25,6 @@ from rsmhp.studies.frontier.chunks import confirm_chunks
 from rsmhp.studies.horizon.chunks import units
 from tests.pipeline.test_workflow import ROOT, TINY, snakemake
 
-pytestmark = pytest.mark.workflow
-
 UNSPLIT = "split={" + ", ".join(f"{r}: 1" for r in SPLIT_RULES) + "}"
 #: merged tables with no measured column: the same bytes, split or not
 SAME = [
@@ -56,12 +54,11 @@ def _jobs(out: str) -> dict[str, int]:
     return {r: int(n) for r, n in re.findall(r"^(\w+)\s+(\d+)$", stats, flags=re.M)}
 
 
-def test_dry_run_has_the_configured_jobs(tmp_path):
+def test_dry_run_has_the_configured_jobs(tiny_dry_run):
+    """The session's dry run of the tiny config (no job runs: the fast tier)."""
     cfg = _config()
     split, hz, hzo = cfg["split"], cfg["horizon"]["uav"], cfg["horizon"]["optimiser"]
-    res = snakemake(tmp_path, "-n")
-    out = res.stdout + res.stderr
-    assert res.returncode == 0, out[-3000:]
+    out = tiny_dry_run
     jobs = _jobs(out)
     est = cfg["estimators"]
     want = {
@@ -95,6 +92,7 @@ def test_dry_run_has_the_configured_jobs(tmp_path):
     assert "results/horizon/uav/chunks/paper_H4/1_closed.csv" in out
 
 
+@pytest.mark.workflow
 def test_unsplit_rerun_writes_the_same_tables(run_j2, tmp_path):
     run = tmp_path / "run"
     shutil.copytree(run_j2, run, symlinks=True)

@@ -1,7 +1,8 @@
 """End-to-end runs of the Snakemake workflow on tests/config/tiny.yaml in temporary directories.
 
-The full tiny run (``run_j2``, shared with tests/studies/uav/test_uav_workflow.py) is in
-conftest.py.
+The full tiny run (``run_j2``) and the -j1 run of the simulations it is compared with
+(``run_j1``), each made once per session and shared with every test that reads them, are in
+conftest.py; the dry runs are in test_dry_runs.py (no job runs there: the fast tier).
 """
 
 from __future__ import annotations
@@ -187,20 +188,20 @@ def test_verify_compares_a_run_with_the_reference(run_j2, tmp_path):
     assert res.returncode != 0 and "same configuration" in err and "Traceback" not in err
 
 
-def test_j1_and_j2_give_identical_results(run_j2, tmp_path):
-    res = snakemake(tmp_path, "-j1", "lqg", "estimators")
-    assert res.returncode == 0, res.stderr[-3000:]
+def test_j1_and_j2_give_identical_results(run_j2, run_j1):
+    """The LQG and estimator studies with one worker (``run_j1``: targets lqg, estimators)
+    give the -j2 run's tables."""
     for rel in CSVS:
-        assert (tmp_path / rel).read_bytes() == (run_j2 / rel).read_bytes(), rel
+        assert (run_j1 / rel).read_bytes() == (run_j2 / rel).read_bytes(), rel
     # the ablation's CPU times are measurements; every other column is identical
     for rel, timing in (
         ("results/estimators/ablation.csv", "cpu_seconds"),
         ("results/estimators/summary.csv", "cpu_median"),
     ):
-        a = pd.read_csv(tmp_path / rel).drop(columns=timing)
+        a = pd.read_csv(run_j1 / rel).drop(columns=timing)
         b = pd.read_csv(run_j2 / rel).drop(columns=timing)
         assert a.to_csv(index=False) == b.to_csv(index=False), rel
-    assert not (tmp_path / "results/paper").exists()  # named targets do not build the report
+    assert not (run_j1 / "results/paper").exists()  # named targets do not build the report
 
 
 def test_estimator_study_outputs(run_j2, tiny):
@@ -315,7 +316,7 @@ def test_config_beyond_a_rules_memory_is_refused_before_any_job(run_j2, tmp_path
     assert res.returncode == 0 and "rule lqg_nbo_error" in res.stdout + res.stderr
 
 
-def test_decision_study_outputs(run_j2, tiny, tmp_path):
+def test_decision_study_outputs(run_j2, run_j1, tiny):
     cfg = tiny["decisions"]["lqg"]
     df = pd.read_csv(run_j2 / "results/decisions/lqg_regret.csv")
     assert set(df["a"]) == set(cfg["a_values"]) and set(df["H"]) == set(cfg["H_values"])
@@ -330,10 +331,9 @@ def test_decision_study_outputs(run_j2, tiny, tmp_path):
         assert f"| {cid} |" in report
     assert "](figures/decisions_lqg_regret.png)" in report
     assert (run_j2 / "results/paper/figures/decisions_lqg_regret.png").exists()
-    # one worker gives the same file (seeds keyed on the cell and replicate, not the worker)
-    res = snakemake(tmp_path, "-j1", "results/decisions/lqg_regret.csv")
-    assert res.returncode == 0, res.stderr[-3000:]
-    assert (tmp_path / "results/decisions/lqg_regret.csv").read_bytes() == (
+    # one worker gives the same file (seeds keyed on the cell and replicate, not the worker;
+    # run_j1 made it with -j1 as a named target)
+    assert (run_j1 / "results/decisions/lqg_regret.csv").read_bytes() == (
         run_j2 / "results/decisions/lqg_regret.csv"
     ).read_bytes()
 
@@ -596,40 +596,6 @@ def test_killed_run_resumes_to_identical_results(run_j2, tmp_path):
         pd.read_parquet(run_j2 / "results/uav/steps.parquet"),
         check_exact=True,
     )
-
-
-def test_slurm_profile_plans_every_rule(tmp_path):
-    """workflow/profiles/slurm dry-runs the whole workflow with the SLURM executor plugin
-    (installed by the dev extra) and applies its per-rule resources."""
-    pytest.importorskip("snakemake_executor_plugin_slurm")
-    res = snakemake(tmp_path, "-n", "--profile", str(ROOT / "workflow/profiles/slurm"))
-    out = res.stdout + res.stderr
-    assert res.returncode == 0, out[-3000:]
-    listing = subprocess.run(
-        [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "--list-rules"],
-        capture_output=True,
-        text=True,
-        cwd=tmp_path,
-        check=True,
-    ).stdout
-    every = {line.split()[0] for line in listing.splitlines() if line.strip()}
-    planned = {
-        line.split()[1].rstrip(":")
-        for line in out.splitlines()
-        if line.startswith(("rule ", "localrule "))
-    }
-    # the default target plans every rule except the six study-level target rules and verify
-    targets = {"lqg", "estimators", "uav", "decisions", "frontier", "horizon", "verify"}
-    # ... and the protocol's tuning (its own target, `make tune`) and the exploratory target
-    targets |= {"tune", "frontier_tune", "frontier_tune_timing", "frontier_tune_select"}
-    targets |= {"frontier_exploratory"}
-    # ... and the comparison of new planners with the reference (make compare)
-    targets |= {"compare", "frontier_compare", "frontier_compare_run"}
-    assert planned == every - targets
-    profile = yaml.safe_load((ROOT / "workflow/profiles/slurm/config.yaml").read_text())
-    assert profile["executor"] == "slurm"
-    block = out.split("rule estimators_ablation:", 1)[1].split("\n\n", 1)[0]
-    assert "mem_mb=8000" in block and "runtime=60" in block
 
 
 def test_snakemake_report_holds_every_figure_and_table_with_its_caption(run_j2, tmp_path):

@@ -6,8 +6,9 @@ long-horizon section and HZ-3 say about the regret they show.
 Oracles: every number of the section body is recomputed here from the split rows (means by
 hand, the ranges over methods, the shares of plans at 0 iterations and converged) and must
 appear in the text; the summary's extra column is the share counted by hand; bad config values
-are refused naming the field; the tiny workflow lists the configured jobs per (model, H) and
-its run writes tables that meet their contracts and a section whose numbers are the summary's.
+are refused naming the field; the tiny workflow's dry run lists the configured jobs per (model,
+H) and its run (the session's ``run_j2``) writes tables that meet their contracts and a section
+whose numbers are the summary's.
 """
 
 from __future__ import annotations
@@ -15,7 +16,6 @@ from __future__ import annotations
 import copy
 import json
 import re
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -306,21 +306,10 @@ def test_split_contract_names_the_rule():
 # ----------------------------------------------------------------------------- workflow
 
 
-def _snakemake(workdir: Path, option: str, *targets: str):
-    """``snakemake <option> --configfile tiny.yaml -- <targets>`` in ``workdir``."""
-    import subprocess
-
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(ROOT / "Snakefile"), "-d", str(workdir),
-           option, "--configfile", str(TINY), "--", *targets]  # fmt: skip
-    return subprocess.run(cmd, capture_output=True, text=True, timeout=600)
-
-
-@pytest.mark.workflow
-def test_dry_run_lists_the_jobs_of_every_model_and_horizon(tmp_path):
+def test_dry_run_lists_the_jobs_of_every_model_and_horizon(tiny_dry_run):
+    """The session's dry run of the tiny config's default target, ``all`` (no job runs)."""
     tiny = yaml.safe_load(TINY.read_text())
-    res = _snakemake(tmp_path, "-n", "all")
-    out = res.stdout + res.stderr
-    assert res.returncode == 0, out[-3000:]
+    out = tiny_dry_run
     stats = dict(re.findall(r"^(\w+)\s+(\d+)$", out.split("Job stats:", 1)[1], flags=re.M))
     # split.horizon_optimiser jobs of runs per (model, H) at the largest H, fewer below
     opt = tiny["horizon"]["optimiser"]
@@ -335,36 +324,35 @@ def test_dry_run_lists_the_jobs_of_every_model_and_horizon(tmp_path):
 
 
 @pytest.mark.workflow
-def test_tiny_run_of_the_new_rules(tmp_path):
-    """The three rules on the tiny config (about 10 s on 2 cores): tables meet their
-    contracts, the summary is the split rows', the section's numbers are the summary's."""
+def test_tiny_run_of_the_new_rules(run_j2):
+    """The rules' outputs in the session's tiny run (``run_j2``, which made
+    results/report/horizon_optimiser.json and results/figures/horizon_optimiser.png among
+    everything else): tables meet their contracts, the summary is the split rows', the
+    section's numbers are the summary's."""
     tiny = yaml.safe_load(TINY.read_text())
     opt = tiny["horizon"]["optimiser"]
-    res = _snakemake(tmp_path, "-j2", "results/report/horizon_optimiser.json",
-                     "results/figures/horizon_optimiser.png")  # fmt: skip
-    assert res.returncode == 0, (res.stdout + res.stderr)[-3000:]
     cfg = {**CONFIG["horizon"]["optimiser"], **opt, "methods": {
         **CONFIG["horizon"]["optimiser"]["methods"], **opt["methods"]}}  # fmt: skip
     table = pd.concat(
         [
             read_checked(
-                tmp_path / f"results/horizon/optimiser/paper_H{h}.csv",
+                run_j2 / f"results/horizon/optimiser/paper_H{h}.csv",
                 split_contract(cfg, "paper", h),
             )
             for h in opt["H"]
         ],
         ignore_index=True,
     )
-    summary = pd.read_csv(tmp_path / "results/horizon/optimiser_summary.csv")
+    summary = pd.read_csv(run_j2 / "results/horizon/optimiser_summary.csv")
     want = optimiser_summary(table)
     pd.testing.assert_frame_equal(summary[SUMMARY_COLUMNS], want, check_dtype=False)
-    section = json.loads((tmp_path / "results/report/horizon_optimiser.json").read_text())
+    section = json.loads((run_j2 / "results/report/horizon_optimiser.json").read_text())
     assert section["key"] == KEY and section["order"] == ORDER and section["claims"] == []
     d = want[(want["maxiter"] == opt["budgets"][0]["maxiter"]) & (want["restarts"] == 0)]
     for h in opt["H"]:
         g = d[d["H"] == h]
         assert f"H = {h}: R {_pct(g['regret_pct'])}, A {_pct(g['approx_pct'])}" in section["body"]
-    assert (tmp_path / "results/tables/horizon_optimiser.md").read_text().startswith("| model")
-    png = (tmp_path / "results/figures/horizon_optimiser.png").read_bytes()
+    assert (run_j2 / "results/tables/horizon_optimiser.md").read_text().startswith("| model")
+    png = (run_j2 / "results/figures/horizon_optimiser.png").read_bytes()
     assert png[:8] == b"\x89PNG\r\n\x1a\n"
-    assert "done in" in (tmp_path / "results/logs/horizon_optimiser_summary.log").read_text()
+    assert "done in" in (run_j2 / "results/logs/horizon_optimiser_summary.log").read_text()

@@ -99,17 +99,16 @@ def test_uav_recording(run_j2, tiny):
         assert counts[f"/{m}/map/hypotheses"] == K and counts[f"/error/{m}"] == K + 1
 
 
-def test_uav_j1_equals_j2_except_wall_time(run_j2, tmp_path):
-    res = snakemake(tmp_path, "-j1", "uav_collect")
-    assert res.returncode == 0, res.stderr[-3000:]
+def test_uav_j1_equals_j2_except_wall_time(run_j2, run_j1):
+    """The session's -j1 run (``run_j1``, target uav_collect among others) against -j2."""
     a = pd.read_csv(run_j2 / "results/uav/runs.csv")
-    b = pd.read_csv(tmp_path / "results/uav/runs.csv")
+    b = pd.read_csv(run_j1 / "results/uav/runs.csv")
     cols = [c for c in a.columns if c not in NONDETERMINISTIC_COLUMNS]
     assert cols == [c for c in b.columns if c not in NONDETERMINISTIC_COLUMNS]
     pd.testing.assert_frame_equal(a[cols], b[cols], check_exact=True)
     assert not a["plan_seconds"].equals(b["plan_seconds"])  # wall time really is excluded
     sa = pd.read_parquet(run_j2 / "results/uav/steps.parquet")
-    sb = pd.read_parquet(tmp_path / "results/uav/steps.parquet")
+    sb = pd.read_parquet(run_j1 / "results/uav/steps.parquet")
     pd.testing.assert_frame_equal(sa, sb, check_exact=True)
 
 
