@@ -294,9 +294,10 @@ def _content(path: Path, aside: list[str]) -> str:
 @pytest.mark.workflow
 @pytest.mark.compile  # every kernel compiled for the generic CPU in the emulated run
 def test_drill_on_the_tiny_config(run_j2, tmp_path):
-    """The emulated tiny run: numba compiled every kernel for the generic CPU, OpenBLAS ran on
-    another core type (both recorded inside the run), every verdict is the native run's, the
-    native results are untouched, and each table is classified as its content says."""
+    """The emulated tiny run: numba compiled every kernel for the generic CPU (in the warm-up,
+    none in a job), OpenBLAS ran on another core type (both recorded inside the run), every
+    verdict is the native run's, the native results are untouched, and each table is
+    classified as its content says."""
     before = _files(run_j2 / "results")
     emulated = tmp_path / "emulated"
     t0 = time.perf_counter()
@@ -342,6 +343,17 @@ def test_drill_on_the_tiny_config(run_j2, tmp_path):
         v == ["generic"] for v in emu["emulated numba cache"].values()
     )
     assert not list((emulated / ".drill/workflow/src").rglob("*.nb[ic]"))
+    # ... by the warm-up, from the copy's src/ that the jobs import (numba's cache is keyed on
+    # the source file): no job of the run compiled a kernel, each loaded what it used
+    jobs = [r for r in pt.read_records(emulated / ".drill/records") if r.get("rule")]
+    assert {"uav_simulate", "horizon_uav"} <= {r["rule"] for r in jobs}
+    compiled = [
+        (r["rule"], name)
+        for r in jobs
+        for name, k in r.get("numba", {}).get("kernels", {}).items()
+        if k["compiled"]
+    ]
+    assert not compiled, compiled
     # OpenBLAS: the emulated core type inside every process and in the run's provenance
     assert inside["openblas core types"] == ["Nehalem"]
     assert "Nehalem" not in emu["native"]["openblas"]

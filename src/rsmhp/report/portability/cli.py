@@ -276,9 +276,13 @@ def _run_workflows(plan: _Plan, envs: _Environments) -> None:
     print(f"portability: emulated run in {plan.workdir}", flush=True)
     log = plan.drill_dir / "snakemake.log"
     # compile the emulated CPU's kernels first, on every core (rsmhp.pipeline.warm): the
-    # workflow's jobs would each compile what they call, two at once compiling the same kernel
+    # workflow's jobs would each compile what they call, two at once compiling the same kernel.
+    # From the copy's src/, first on the path as in its jobs: numba's cache is keyed on the
+    # source file, so kernels compiled from the checkout's src/ would not be the jobs'
     warm = [sys.executable, "-m", "rsmhp.pipeline.warm", "--cores", str(args.cores)]
-    if subprocess.run(warm, env=envs.emulated, check=False).returncode:
+    src = str(envs.snakefile.parent / "src")
+    path = os.pathsep.join(filter(None, [src, envs.emulated.get("PYTHONPATH")]))
+    if subprocess.run(warm, env={**envs.emulated, "PYTHONPATH": path}, check=False).returncode:
         raise _Abort("compiling the kernels for the emulated CPU failed")
     if _snakemake(
         plan.workdir,
