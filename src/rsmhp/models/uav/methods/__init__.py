@@ -183,7 +183,10 @@ def _check_class(cls: type[Method]) -> None:
             isinstance(cls.family_label, str) and cls.family_label.strip() != "",
             "a non-empty string",
         ),
-        "colour_key": (isinstance(cls.colour_key, str), "a string (a key of the report's colours or '#rrggbb')"),
+        "colour_key": (
+            isinstance(cls.colour_key, str),
+            "a string (a key of the report's colours or '#rrggbb')",
+        ),
         "order": (isinstance(cls.order, int) and not isinstance(cls.order, bool), "an int"),
         **{
             a: (isinstance(getattr(cls, a), bool), "a bool")
