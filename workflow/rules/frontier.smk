@@ -402,7 +402,9 @@ rule frontier_confirm_summary:
         exploratory=os.path.join(
             workflow.basedir, "paper/exploratory/claims_76a0c01.json"
         ),
-        superseded=os.path.join(workflow.basedir, "paper/superseded/claims_confirm1.json"),
+        superseded=os.path.join(
+            workflow.basedir, "paper/superseded/claims_confirm1.json"
+        ),
     output:
         summary="results/frontier/confirm_summary.csv",
         ladder="results/frontier/confirm_ladder.csv",
