@@ -126,12 +126,10 @@ test: lint $(PLUGIN_STAMP)
 
 # the quick tier (tests/conftest.py): every test but those that run the workflow for real
 # (workflow), on the local SLURM cluster (slurm) or compile numba kernels cold or for another
-# CPU (compile); no lint. make test runs them all. With pytest-xdist installed the tier runs
-# on CORES worker processes (its tests share no session-wide run: each worker has its own)
+# CPU (compile); no lint. make test runs them all.
 FAST := not workflow and not slurm and not compile
-XDIST = $(shell $(BIN)/python -c "import xdist" 2>/dev/null && printf '%s' "-n $(CORES)")
 test-fast: $(PLUGIN_STAMP)
-	$(BIN)/python -m pytest --durations=10 $(XDIST) -m "$(FAST)" tests $(PLUGIN)/tests
+	$(BIN)/python -m pytest --durations=10 -m "$(FAST)" tests $(PLUGIN)/tests
 
 clean:
 	rm -rf results .snakemake

@@ -171,10 +171,17 @@ def run_j1(tmp_path_factory) -> Path:
 @pytest.fixture(scope="session")
 def tiny_dry_run(tmp_path_factory) -> str:
     """``snakemake -n`` of the tiny config's default target from an empty directory (its
-    output): the job layout the dry-run tests check (no job runs)."""
-    from tests.pipeline.test_workflow import snakemake
+    output), through the SLURM profile (workflow/profiles/slurm: the same jobs, with the
+    cluster's threads and resources) when its executor plugin is installed, as the dev extra
+    does: the job layout and resources the dry-run tests check (no job runs)."""
+    import importlib.util
 
-    res = snakemake(tmp_path_factory.mktemp("dry"), "-n")
+    from tests.pipeline.test_workflow import ROOT, snakemake
+
+    profile = ["--profile", str(ROOT / "workflow/profiles/slurm")]
+    if importlib.util.find_spec("snakemake_executor_plugin_slurm") is None:
+        profile = []
+    res = snakemake(tmp_path_factory.mktemp("dry"), "-n", *profile)
     out = res.stdout + res.stderr
     assert res.returncode == 0, out[-3000:]
     return out
