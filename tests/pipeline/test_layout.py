@@ -265,3 +265,31 @@ def test_the_rule_file_check_can_fail(tmp_path):
     b = tmp_path / "b.smk"
     b.write_text('rule x:\n    input: expand("{j}", j=FOO_JOBS)\n')
     assert "FOO_JOBS" in _globals(a) and "FOO_JOBS" in _USED.findall(_strip_strings(b.read_text()))
+
+
+#: the UAV simulation rules: their scripts' imports leave scipy.stats and scipy.optimize out
+UAV_SIMULATION_SCRIPTS = (
+    "uav_simulate", "uav_recording", "decisions_uav", "decisions_map_cell", "frontier_confirm",
+    "frontier_confirm_timing", "frontier_explore", "frontier_explore_timing", "horizon_uav",
+    "horizon_uav_closed", "horizon_optimiser",
+)  # fmt: skip
+
+
+def test_a_uav_simulation_job_does_not_import_scipy_stats_or_optimize():
+    """What a UAV simulation job imports leaves scipy.stats and scipy.optimize unloaded, the
+    example plugin included (each costs every job ~0.4 s at start; the planner's scipy
+    oracle, the Sobol' direction numbers and Spearman's rho import them when first used)."""
+    import subprocess
+    import sys
+
+    modules = set()
+    for name in UAV_SIMULATION_SCRIPTS:
+        text = (ROOT / "workflow" / "scripts" / f"{name}.py").read_text()
+        modules |= set(re.findall(r"^(?:from|import) (rsmhp[\w.]*)", text, flags=re.M))
+    assert "rsmhp.studies.uav.simulate" in modules, modules
+    code = (
+        f"import importlib, sys\nfor m in {sorted(modules)!r}: importlib.import_module(m)\n"
+        "print(sorted(m for m in ('scipy.stats', 'scipy.optimize') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]", out.stdout + out.stderr

@@ -262,9 +262,12 @@ def test_sobol_points_are_scipys_bit_for_bit(d, m, extra, seed):
 
 
 def test_sobol_points_refuse_bad_arguments():
+    from scipy.stats import qmc
+
     from rsmhp.core import designs
 
     rng = np.random.default_rng(0)
+    assert designs.SOBOL_MAXDIM == qmc.Sobol.MAXDIM  # our copy of scipy's limit
     with pytest.raises(ValueError, match=r"d must be at most 21201, got 30000"):
         designs.sobol_points(rng, 4, 30000)
     with pytest.raises(ValueError, match=r"n"):

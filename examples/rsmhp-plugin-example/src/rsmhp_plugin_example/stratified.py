@@ -28,8 +28,6 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 import numpy as np
-from scipy import special
-from scipy.stats import qmc
 
 from rsmhp.core import guards
 from rsmhp.models.uav.methods import register
@@ -48,6 +46,9 @@ def latin_hypercube(rng: np.random.Generator, n: int, d: int) -> np.ndarray:
     n = guards.positive_int("n", n)
     d = guards.positive_int("d", d)
     guards.generator("rng", rng)
+    # scipy.stats is imported when first used: the registry imports every plugin in every job
+    from scipy.stats import qmc
+
     return qmc.LatinHypercube(d=d, scramble=True, rng=rng).random(n)
 
 
@@ -60,6 +61,8 @@ def lhs_design(
     chol = np.asarray(chol, dtype=float)
     d = chol.shape[0]
     u = latin_hypercube(rng, n, H * d)
+    from scipy import special
+
     z = special.ndtri(np.clip(u, _EPS, 1.0 - _EPS))  # the normal quantile, Phi^-1
     return z.reshape(n, H, d) @ chol.T, np.full(n, 1.0 / n)
 

@@ -38,16 +38,18 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 
 import numpy as np
-from scipy.optimize import Bounds, minimize
 
 from rsmhp.core import guards
 from rsmhp.models.uav import fused
 from rsmhp.models.uav.kinematics import UAVParams
 from rsmhp.models.uav.sensor import SensorModel
 from rsmhp.models.uav.target import TargetModel
+
+if TYPE_CHECKING:
+    import scipy.optimize
 
 __all__ = [
     "LBFGSB",
@@ -272,9 +274,11 @@ def shift_plan(controls: np.ndarray) -> np.ndarray:
 
 
 @functools.cache
-def _box(n: int) -> Bounds:
+def _box(n: int) -> scipy.optimize.Bounds:
     """The normalised control box [-1, 1]^n (built once per size: scipy's bounds parsing is a
     large share of a small problem's optimiser overhead)."""
+    from scipy.optimize import Bounds
+
     return Bounds(np.full(n, -1.0), np.full(n, 1.0))
 
 
@@ -291,6 +295,10 @@ def lbfgsb(problem: PlanningProblem, x0: np.ndarray, maxiter: int, maxfun: int |
 
 
 def _lbfgsb(problem: PlanningProblem, x0: np.ndarray, maxiter: int, maxfun: int | None = None):
+    # scipy.optimize is imported here, not with the module: the default optimiser (BoxQN) does
+    # not need it, and it costs every job that imports the planner ~0.4 s
+    from scipy.optimize import minimize
+
     options = {"maxiter": maxiter} if maxfun is None else {"maxiter": maxiter, "maxfun": maxfun}
     return minimize(
         problem.value_and_grad,

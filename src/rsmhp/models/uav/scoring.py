@@ -51,7 +51,6 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from scipy import stats
 from threadpoolctl import threadpool_limits
 
 from rsmhp.core.seeding import job_rng
@@ -339,6 +338,8 @@ def _spearman(a: np.ndarray, b: np.ndarray) -> float:
     hypothesis is out of every plan's footprint: the cost cannot rank the plans)."""
     if np.ptp(a) == 0.0 or np.ptp(b) == 0.0:
         return float("nan")
+    from scipy import stats  # on first use: scipy.stats costs every importing job ~0.4 s
+
     return float(stats.spearmanr(a, b).statistic)
 
 
