@@ -293,3 +293,24 @@ def test_a_uav_simulation_job_does_not_import_scipy_stats_or_optimize():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]", out.stdout + out.stderr
+
+
+def test_parsing_the_workflow_imports_no_plotting_or_scipy_submodule():
+    """What the Snakefile and the rule files import when Snakemake parses them leaves
+    matplotlib, seaborn and scipy's stats, optimize and integrate unloaded (about 1.2 s a
+    parse, paid by every snakemake command and by every job of a cluster run): a rule file
+    takes its outputs' names from its study's package, not from its figure or section code."""
+    import subprocess
+    import sys
+
+    modules = set()
+    for path in [ROOT / "Snakefile", *sorted((ROOT / "workflow" / "rules").glob("*.smk"))]:
+        modules |= set(re.findall(r"^(?:from|import) (rsmhp[\w.]*)", path.read_text(), re.M))
+    assert {"rsmhp.studies.frontier", "rsmhp.pipeline.config"} <= modules, modules
+    heavy = ("matplotlib", "seaborn", "scipy.stats", "scipy.optimize", "scipy.integrate")
+    code = (
+        f"import importlib, sys\nfor m in {sorted(modules)!r}: importlib.import_module(m)\n"
+        f"print(sorted(m for m in {heavy!r} if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]", out.stdout + out.stderr

@@ -1,8 +1,8 @@
 # Decision-quality study: the regret of the controls each method chooses.
 # Simulation, aggregation and figures are separate rules; the sensitivity map runs one job
 # per cell (wildcard {cell} = r<i>c<j>), so a cell reruns alone and cells fan out.
-from rsmhp.studies.decisions.section_lqg import FIGURES as DEC_LQG_FIGURES
-from rsmhp.studies.decisions.section_uav import FIGURES as DEC_UAV_FIGURES
+from rsmhp.studies.decisions import FIGURES_LQG as DEC_LQG_FIGURES
+from rsmhp.studies.decisions import FIGURES_UAV as DEC_UAV_FIGURES
 from rsmhp.studies.decisions.chunks import chunk_jobs, model_runs
 
 DEC = config["decisions"]

@@ -3,10 +3,9 @@
 # (one thread: the time is the study's measure of compute), then aggregation and the figure.
 import numpy as np
 
-from rsmhp.studies.frontier.figures import CONFIRM_FIGURES
-from rsmhp.studies.frontier.figures import FIGURES as FRONTIER_FIGURES
-from rsmhp.studies.frontier.section import CONFIRM_TABLES
-from rsmhp.studies.frontier.section import TABLES as FRONTIER_TABLES
+from rsmhp.studies.frontier import CONFIRM_FIGURES, CONFIRM_TABLES
+from rsmhp.studies.frontier import FIGURES as FRONTIER_FIGURES
+from rsmhp.studies.frontier import TABLES as FRONTIER_TABLES
 from rsmhp.pipeline.protocol import tuned_configurations
 from rsmhp.studies.frontier.chunks import confirm_chunks, confirm_runs
 from rsmhp.studies.frontier.reference import (

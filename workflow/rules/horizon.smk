@@ -3,10 +3,9 @@
 # (one thread), paired closed-loop runs per (model, H); the oven LQG (horizon.lqg): cost
 # estimators and decision regret at long horizons against exact oracles; then aggregation,
 # claims and report section, and the figures.
-from rsmhp.studies.horizon.figures import FIGURES as HORIZON_FIGURES
-from rsmhp.studies.horizon.figures_optimiser import FIGURES as OPTIMISER_FIGURES
-from rsmhp.studies.horizon.section import TABLES as HORIZON_TABLES
-from rsmhp.studies.horizon.section_optimiser import TABLES as OPTIMISER_TABLES
+from rsmhp.studies.horizon import FIGURES as HORIZON_FIGURES
+from rsmhp.studies.horizon import OPTIMISER_FIGURES, OPTIMISER_TABLES
+from rsmhp.studies.horizon import TABLES as HORIZON_TABLES
 from rsmhp.pipeline.protocol import stream_seed
 from rsmhp.studies.horizon.chunks import layout_runs, unit_files, units
 

@@ -3,8 +3,8 @@
 # and (rsmhp.studies.scenarios.best) the method with the lowest closed-loop error per cell of
 # the confirmatory equal-compute run (per model and budget), the long-horizon closed loop (per
 # model and H) and the map (per cell), with the confidence of that answer (descriptive, no claim).
-from rsmhp.studies.scenarios.figures import FIGURES as SCENARIO_FIGURES
-from rsmhp.studies.scenarios.section import TABLES as SCENARIO_TABLES
+from rsmhp.studies.scenarios import FIGURES as SCENARIO_FIGURES
+from rsmhp.studies.scenarios import TABLES as SCENARIO_TABLES
 
 SCN_MAP = expand("results/decisions/map/{cell}.csv", cell=MAP_CELLS)
 SCN_CLOSED = expand("results/horizon/uav/{job}_closed.csv", job=HZ_JOBS)

@@ -27,7 +27,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
+import scipy  # scipy.stats loads on first use (scipy's lazy submodules): ~0.4 s a process
 
 from rsmhp.core import guards
 
@@ -69,7 +69,7 @@ def mean_ci(x: np.ndarray, level: float = 0.95) -> tuple[float, float, float]:
     if n < 2:
         raise ValueError(f"need at least 2 values x for a confidence interval, got {n}")
     m = float(x.mean())
-    half = float(stats.t.ppf(0.5 + level / 2, n - 1) * x.std(ddof=1) / np.sqrt(n))
+    half = float(scipy.stats.t.ppf(0.5 + level / 2, n - 1) * x.std(ddof=1) / np.sqrt(n))
     return m, m - half, m + half
 
 
@@ -78,7 +78,7 @@ def binomial_ci(k: int, n: int, level: float = 0.95) -> tuple[float, float]:
     n = guards.positive_int("n", n)
     k = guards.integer("k", k, minimum=0, maximum=n)
     _level(level)
-    ci = stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="exact")
+    ci = scipy.stats.binomtest(int(k), int(n)).proportion_ci(confidence_level=level, method="exact")
     return float(ci.low), float(ci.high)
 
 
@@ -91,8 +91,8 @@ def rmse_ci(err: np.ndarray, level: float = 0.95) -> tuple[float, float, float]:
     if n < 1:
         raise ValueError("need at least 1 error value err for an RMSE, got 0")
     ss = float(np.sum(err**2))
-    lo = np.sqrt(ss / stats.chi2.ppf(0.5 + level / 2, n))
-    hi = np.sqrt(ss / stats.chi2.ppf(0.5 - level / 2, n))
+    lo = np.sqrt(ss / scipy.stats.chi2.ppf(0.5 + level / 2, n))
+    hi = np.sqrt(ss / scipy.stats.chi2.ppf(0.5 - level / 2, n))
     return float(np.sqrt(ss / n)), float(lo), float(hi)
 
 
@@ -115,8 +115,8 @@ def loglog_slope(x: np.ndarray, y: np.ndarray, level: float = 0.95) -> SlopeFit:
         raise ValueError(f"x and y must have the same length, got {x.size} and {y.size}")
     if x.size < 3 or np.any(x <= 0) or np.any(y <= 0):
         raise ValueError("need >= 3 strictly positive points for a log-log fit")
-    res = stats.linregress(np.log(x), np.log(y))
-    half = float(stats.t.ppf(0.5 + level / 2, x.size - 2) * res.stderr)
+    res = scipy.stats.linregress(np.log(x), np.log(y))
+    half = float(scipy.stats.t.ppf(0.5 + level / 2, x.size - 2) * res.stderr)
     return SlopeFit(
         float(res.slope), float(res.slope - half), float(res.slope + half), float(res.intercept)
     )
@@ -196,7 +196,7 @@ def exceedance_test(
     alpha = (1 - level) / m
     p = np.array(
         [
-            stats.binomtest(int(ki), int(ni), float(pi)).pvalue
+            scipy.stats.binomtest(int(ki), int(ni), float(pi)).pvalue
             for ki, ni, pi in zip(k, n, exact, strict=True)
         ]
     )
@@ -241,7 +241,7 @@ def detectable_scale(
     se = np.sqrt(max(p * (1 - p), 0.0) / n)
     if se == 0:
         return float("inf")
-    need = (stats.norm.ppf(1 - (1 - level) / cells / 2) + stats.norm.ppf(power)) * se
+    need = (scipy.stats.norm.ppf(1 - (1 - level) / cells / 2) + scipy.stats.norm.ppf(power)) * se
     best = float("inf")
     for sign in (1.0, -1.0):
         delta = sign * grid[np.abs(grid) < 1] if sign < 0 else grid
@@ -259,10 +259,10 @@ def _t_p_value(t_stat: float, df: float, side: str) -> float:
     """p-value of a t statistic with ``df`` degrees of freedom: ``"two"`` (two-sided),
     ``"below"`` (H1: the mean is below the null, small t rejects) or ``"above"``."""
     if side == "two":
-        return float(min(1.0, 2.0 * stats.t.sf(abs(t_stat), df)))
+        return float(min(1.0, 2.0 * scipy.stats.t.sf(abs(t_stat), df)))
     if side == "below":
-        return float(stats.t.cdf(t_stat, df))
-    return float(stats.t.sf(t_stat, df))
+        return float(scipy.stats.t.cdf(t_stat, df))
+    return float(scipy.stats.t.sf(t_stat, df))
 
 
 def _se_zero_p_value(diff: float, side: str) -> float:
@@ -342,7 +342,7 @@ def cluster_t_ci(
         ]
     )
     se = float(np.sqrt((g - 1) / g * np.sum((loo - loo.mean()) ** 2)))
-    half = float(stats.t.ppf(0.5 + level / 2, g - 1)) * se
+    half = float(scipy.stats.t.ppf(0.5 + level / 2, g - 1)) * se
     return ClusterInterval(estimate, estimate - half, estimate + half, se, g - 1)
 
 
@@ -451,9 +451,9 @@ def t_power(n: int, sd: float, effect: float, level: float = 0.95) -> float:
             raise ValueError("sd = 0 and effect = 0 leave the t statistic undefined (0/0)")
         return 1.0
     df = n - 1
-    crit = float(stats.t.ppf(0.5 + level / 2, df))
+    crit = float(scipy.stats.t.ppf(0.5 + level / 2, df))
     nc = effect * np.sqrt(n) / sd
-    return float(min(1.0, stats.nct.sf(crit, df, nc) + stats.nct.cdf(-crit, df, nc)))
+    return float(min(1.0, scipy.stats.nct.sf(crit, df, nc) + scipy.stats.nct.cdf(-crit, df, nc)))
 
 
 def runs_for_power(
@@ -486,7 +486,7 @@ def runs_for_power(
             f"sd = {sd:g}, level = {level:g} (power at max_n: "
             f"{t_power(max_n, sd, effect, level):.4g}); raise max_n or the effect"
         )
-    z = stats.norm.ppf(0.5 + level / 2) + stats.norm.ppf(power)
+    z = scipy.stats.norm.ppf(0.5 + level / 2) + scipy.stats.norm.ppf(power)
     start = int(min(max_n, max(2, np.ceil((z * sd / effect) ** 2))))
     if reaches(start):
         hi = start

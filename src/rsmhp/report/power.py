@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import math
 
-from scipy import stats as _st
+import scipy  # scipy.stats loads on first use (scipy's lazy submodules)
 
 from rsmhp.report.ledger import KeyNumber
 
@@ -39,7 +39,7 @@ POWER = 0.80
 
 
 def _t(q: float, df: float) -> float:
-    return float(_st.t.ppf(q, df))
+    return float(scipy.stats.t.ppf(q, df))
 
 
 def _runs_for(sigma: float, delta: float, power: float) -> int:

@@ -25,7 +25,7 @@ from collections.abc import Callable, Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats as _st
+import scipy  # scipy.stats loads on first use (scipy's lazy submodules)
 
 from rsmhp.core.stats import ExceedanceTest, holm
 from rsmhp.report.ledger import STATEMENT_VERDICTS, Claim, Section
@@ -214,7 +214,7 @@ def decisive_p(
         if se == 0:
             ps.append(0.0 if dist > 0 else 1.0)
         else:
-            ps.append(float(min(1.0, 2 * _st.t.sf(dist / se, df))))
+            ps.append(float(min(1.0, 2 * scipy.stats.t.sf(dist / se, df))))
     return max(ps)
 
 

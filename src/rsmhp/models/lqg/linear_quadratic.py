@@ -52,7 +52,7 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from scipy import integrate, special
+import scipy  # scipy.integrate and scipy.special load on first use (scipy's lazy submodules)
 
 from rsmhp.core import guards
 from rsmhp.core.sampling import GaussianNoise
@@ -126,7 +126,7 @@ def _quad(f: Callable[[float], float], a: float, b: float, **kw) -> tuple[float,
     """:func:`scipy.integrate.quad` returning ``(value, error estimate, converged)`` instead of
     warning (``full_output`` silences QUADPACK's messages; ``ier != 0`` means not converged)."""
     kw.setdefault("epsrel", _QUAD_EPSREL)
-    out = integrate.quad(f, a, b, full_output=1, epsabs=_QUAD_EPSABS, **kw)
+    out = scipy.integrate.quad(f, a, b, full_output=1, epsabs=_QUAD_EPSABS, **kw)
     return float(out[0]), float(out[1]), len(out) == 3
 
 
@@ -260,7 +260,7 @@ class _MeanErrorLaw:
             return 0.0, 1.0 / e**2, True
         T, tail_needed = cut
         total, err, ok = _quad(self._amplitude, 0.0, T, weight="sin", wvar=e, limit=2000)
-        total += float(special.sici(e * T)[0])
+        total += float(scipy.special.sici(e * T)[0])
         if tail_needed:
             t_val, t_err, t_ok = self._tail_integral(e, T)
             total, err, ok = total + t_val, err + t_err, ok and t_ok
@@ -462,7 +462,7 @@ class QuadraticForm:
             out = (flat == 0.0).astype(float)
         elif not np.any(lam):
             sd = math.sqrt(var / n)  # var = b^T S b here (sum of beta^2: no lambda part)
-            out = special.erfc(flat / (sd * math.sqrt(2.0)))  # 2 Phi(-eps/sd)
+            out = scipy.special.erfc(flat / (sd * math.sqrt(2.0)))  # 2 Phi(-eps/sd)
         else:
             law = _MeanErrorLaw(lam, beta, n)
             cut = law.cutoff()

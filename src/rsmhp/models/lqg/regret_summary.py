@@ -36,7 +36,7 @@ from typing import Any, NamedTuple
 
 import numpy as np
 import pandas as pd
-from scipy import stats as sps
+import scipy  # scipy.stats loads on first use (scipy's lazy submodules)
 
 from rsmhp.core.stats import loglog_slope, mean_ci
 from rsmhp.models.lqg import oven as lqg
@@ -191,7 +191,7 @@ def slopes(scaling: pd.DataFrame, method: str, weighting: str = "uniform") -> pd
 def bonferroni(n_tests: int, level: float = 0.95) -> float:
     r"""Two-sided normal limit of ``n_tests`` z-scores at family-wise ``level``:
     :math:`\Phi^{-1}(1 - (1 - \text{level})/(2m))`."""
-    return float(sps.norm.ppf(1.0 - (1.0 - level) / (2 * max(n_tests, 1))))
+    return float(scipy.stats.norm.ppf(1.0 - (1.0 - level) / (2 * max(n_tests, 1))))
 
 
 class ZCheck(NamedTuple):

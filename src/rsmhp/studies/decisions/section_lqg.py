@@ -24,12 +24,10 @@ from rsmhp.models.lqg.regret_summary import (
 from rsmhp.report.ledger import Claim, Section
 from rsmhp.report.markdown import fmt, fmt_ci, markdown_table, param_text, range_text
 from rsmhp.report.templates import render
+from rsmhp.studies.decisions import FIGURES_LQG as FIGURES
 from rsmhp.studies.decisions.claims_lqg import lqg_claims
 
 __all__ = ["FIGURES", "lqg_decision_section", "lqg_tables", "shown_a"]
-
-#: figure stems of the section (the figure rule writes them; see decisions.smk)
-FIGURES = ("decisions_lqg_regret",)
 
 
 def _render(template: str, **values: Any) -> str:

@@ -18,6 +18,7 @@ from rsmhp.report.ledger import Claim, Section
 from rsmhp.report.markdown import ci_cells, fmt, fmt_ci, markdown_table, param_text
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import render
+from rsmhp.studies.decisions import FIGURES_UAV as FIGURES
 from rsmhp.studies.decisions.claims_uav import pp, uav_claims
 from rsmhp.studies.decisions.summarise_uav import (
     EARLY_STEP,
@@ -31,9 +32,6 @@ from rsmhp.studies.decisions.summarise_uav import (
 )
 
 __all__ = ["FIGURES", "uav_decision_section", "uav_tables"]
-
-#: figure stems of the section (the figure rule writes them; see decisions.smk)
-FIGURES = ("decisions_uav_regret", "decisions_uav_map")
 
 
 def _render(template: str, **values: Any) -> str:

@@ -28,13 +28,10 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, LogLocator, NullForma
 from rsmhp.models.uav import methods
 from rsmhp.report.figures import theme
 from rsmhp.report.palette import METHOD_COLOURS, method_colour
+from rsmhp.studies.frontier import CONFIRM_FIGURES, FIGURES
 
 __all__ = ["CONFIRM_FIGURES", "FIGURES", "confirm_figure", "frontier_figure"]
 
-#: the confirmatory run's figure (:func:`confirm_figure`)
-CONFIRM_FIGURES = ["frontier_confirm"]
-
-FIGURES = ["frontier_exploratory"]
 
 _ROWS = (
     ("regret_diff_pp", "open-loop regret − NBO's (pp)"),

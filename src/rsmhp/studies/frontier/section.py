@@ -20,6 +20,7 @@ from rsmhp.report.ledger import Claim, Section
 from rsmhp.report.markdown import ci_cells, fmt, fmt_ci, markdown_table, param_text
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import render
+from rsmhp.studies.frontier import CONFIRM_TABLES, TABLES
 from rsmhp.studies.frontier.claims import frontier_claims
 from rsmhp.studies.frontier.figures import FIGURES
 from rsmhp.studies.frontier.summarise import budget_check
@@ -35,9 +36,6 @@ __all__ = [
     "frontier_section",
     "frontier_tables",
 ]
-
-#: table stems of the section (the summary rule writes them; see frontier.smk)
-TABLES = ("frontier_exploratory", "frontier_budget")
 
 
 def _frontier_table(summary: pd.DataFrame) -> str:
@@ -278,9 +276,6 @@ def frontier_section(inputs: FrontierInputs) -> Section:
 
 
 # ------------------------------------------------------------------------ the protocol
-
-#: table stems of the confirmatory section (rule frontier_confirm_summary)
-CONFIRM_TABLES = ("frontier_confirm", "frontier_confirm_ladder", "frontier_confirm_tuning")
 
 
 def _config_table(summary: pd.DataFrame) -> str:

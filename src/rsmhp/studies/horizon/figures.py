@@ -27,6 +27,7 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLo
 from rsmhp.models.uav import methods as _registry  # noqa: F401  (UAV method names get their colours)
 from rsmhp.report.figures import theme
 from rsmhp.report.palette import METHOD_COLOURS, method_colour, method_label, size_shade
+from rsmhp.studies.horizon import FIGURES
 
 __all__ = [
     "FIGURES",
@@ -36,7 +37,6 @@ __all__ = [
     "horizon_time_figure",
 ]
 
-FIGURES = ["horizon_uav_error", "horizon_uav_time", "horizon_uav_closed", "horizon_lqg"]
 
 #: relative RMSEs below this (%) are drawn at it (the log axis has no 0)
 RMSE_FLOOR_PCT = 1e-3

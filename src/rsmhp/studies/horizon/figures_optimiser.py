@@ -28,6 +28,7 @@ from matplotlib.ticker import FixedLocator, FuncFormatter, NullFormatter, NullLo
 from rsmhp.models.uav import methods as _registry  # noqa: F401  (UAV method names get their colours)
 from rsmhp.report.figures import theme
 from rsmhp.report.palette import method_colour, method_label
+from rsmhp.studies.horizon import OPTIMISER_FIGURES as FIGURES
 
 __all__ = [
     "FIGURES",
@@ -38,7 +39,6 @@ __all__ = [
     "optimiser_figure",
 ]
 
-FIGURES = ["horizon_optimiser"]
 
 #: the symlog axis is linear within ± this many percent
 LINTHRESH_PCT = 0.01

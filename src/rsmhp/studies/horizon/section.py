@@ -19,6 +19,7 @@ from rsmhp.report.ledger import Claim, Section
 from rsmhp.report.markdown import ci_cells, fmt, markdown_table, range_text
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import render
+from rsmhp.studies.horizon import TABLES
 from rsmhp.studies.horizon.claims import (
     PrimaryTest,
     budget_text,
@@ -31,14 +32,7 @@ from rsmhp.studies.horizon.section_optimiser import horizon_note
 
 __all__ = ["FIGURES", "TABLES", "HorizonInputs", "horizon_section", "horizon_tables"]
 
-TABLES = (
-    "horizon_uav_approx",
-    "horizon_uav_regret",
-    "horizon_uav_closed",
-    "horizon_lqg",
-    "horizon_lqg_estimators",
-    "horizon_lqg_regret",
-)
+
 _PACKAGE = "rsmhp.studies.horizon"
 
 

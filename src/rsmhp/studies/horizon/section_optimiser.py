@@ -23,6 +23,7 @@ from rsmhp.report.ledger import Section
 from rsmhp.report.markdown import ci_cells, fmt, markdown_table, range_text
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import render
+from rsmhp.studies.horizon import OPTIMISER_TABLES as TABLES
 from rsmhp.studies.horizon.figures_optimiser import (
     FIGURES,
     budget_label,
@@ -52,7 +53,6 @@ KEY = "horizon_optimiser"
 TITLE = "Optimiser error apart from approximation error"
 #: right after the long-horizon section (33)
 ORDER = 34
-TABLES = ("horizon_optimiser",)
 _PACKAGE = "rsmhp.studies.horizon"
 
 _GROUP = ["model", "H", "method", "family", "maxiter", "restarts"]

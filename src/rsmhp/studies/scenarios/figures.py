@@ -21,12 +21,11 @@ from matplotlib.patches import Patch, Rectangle
 from rsmhp.models.uav import methods
 from rsmhp.report.figures import theme
 from rsmhp.report.palette import METHOD_COLOURS, member_colour, method_label
+from rsmhp.studies.scenarios import FIGURES
 from rsmhp.studies.scenarios.best import BUDGET, GROUPS, HORIZON, SCENARIO, short_label
 
 __all__ = ["FIGURES", "best_figure", "family_colour", "improvement_figure", "short_label"]
 
-#: figure stems (results/figures/<stem>.png)
-FIGURES = ["scenarios_best", "scenarios_improvement"]
 
 _MARKERS = ("o", "s", "D", "^")
 

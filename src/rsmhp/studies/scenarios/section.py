@@ -18,6 +18,7 @@ from rsmhp.report.ledger import Section
 from rsmhp.report.markdown import ci_cells, fmt, markdown_table, param_text
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import render
+from rsmhp.studies.scenarios import TABLES
 from rsmhp.studies.scenarios.best import BUDGET, GROUPS, HORIZON, SCENARIO
 from rsmhp.studies.scenarios.summarise import ALL_GROUP
 
@@ -34,8 +35,6 @@ __all__ = [
 
 #: after the long-horizon and optimiser sections
 ORDER = 35
-#: table stems (results/tables/<stem>.md)
-TABLES = ("scenarios_best", "scenarios_improvement", "scenarios_per_scenario")
 
 #: how the text and the table name each group of :data:`rsmhp.studies.scenarios.best.GROUPS`
 GROUP_NAMES = {
