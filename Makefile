@@ -121,15 +121,20 @@ $(PLUGIN_STAMP): $(STAMP) $(PLUGIN)/pyproject.toml
 	$(BIN)/python -m pip install --quiet -e $(PLUGIN)
 	@touch $(PLUGIN_STAMP)
 
+# the suite on CORES pytest-xdist workers: a test file's tests on one worker (its module-scoped
+# fixtures, the SLURM cluster among them, are made once), the longest first; the session's
+# tiny runs are made once and shared by the workers (tests/conftest.py). Serially:
+# $(BIN)/pytest tests
+XDIST := -n $(CORES) --dist loadfile --no-loadscope-reorder
 test: lint $(PLUGIN_STAMP)
-	$(BIN)/python -m pytest --durations=25 tests $(PLUGIN)/tests
+	$(BIN)/python -m pytest $(XDIST) --durations=25 tests $(PLUGIN)/tests
 
 # the quick tier (tests/conftest.py): every test but those that run the workflow for real
 # (workflow), on the local SLURM cluster (slurm) or compile numba kernels cold or for another
 # CPU (compile); no lint. make test runs them all.
 FAST := not workflow and not slurm and not compile
 test-fast: $(PLUGIN_STAMP)
-	$(BIN)/python -m pytest --durations=10 -m "$(FAST)" tests $(PLUGIN)/tests
+	$(BIN)/python -m pytest $(XDIST) --durations=10 -m "$(FAST)" tests $(PLUGIN)/tests
 
 clean:
 	rm -rf results .snakemake

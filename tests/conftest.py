@@ -106,6 +106,27 @@ def _guarded(item: pytest.Item) -> Iterator[None]:
         subprocess.Popen = original
 
 
+def _start_order(item: pytest.Item) -> int:
+    """When ``item`` starts (lower first, collection order within). Under pytest-xdist (make
+    test: ``--dist loadfile --no-loadscope-reorder``, a test file's tests on one worker, files
+    in the order of their first test here): the file of a test that makes the shared tiny run
+    (:func:`shared_run`), then the SLURM run's (it asks for that run only at its end) and those
+    of slow tests that need no shared run, then the portability drill's (the shared run and
+    its own emulated one), then the rest. So the longest work starts first on both workers
+    and no worker waits long for the shared run. Without xdist, only the order changes."""
+    uses = WORKFLOW_FIXTURES & set(getattr(item, "fixturenames", ()))
+    marks = {m.name for m in item.iter_markers()}
+    if "slurm" in marks:
+        return 1
+    if uses and item.name == "test_outputs_content":
+        return 0
+    if ("workflow" in marks or "compile" in marks) and not uses:
+        return 2
+    if item.name == "test_drill_on_the_tiny_config":
+        return 3
+    return 4
+
+
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
     for item in items:
         if WORKFLOW_FIXTURES & set(getattr(item, "fixturenames", ())):
@@ -114,6 +135,7 @@ def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item
             item.path.relative_to(ROOT).as_posix() in COMPILE_FILES
         ):
             item.add_marker(pytest.mark.compile)
+    items.sort(key=_start_order)  # stable: collection order within each start
 
 
 @pytest.hookimpl(wrapper=True)
@@ -141,15 +163,42 @@ def rng() -> np.random.Generator:
     return np.random.default_rng(12345)
 
 
-@pytest.fixture(scope="session")
-def run_j2(tmp_path_factory) -> Path:
-    """The whole workflow (LQG, UAV, report) on the tiny config with -j2, run once per session."""
+def shared_run(request: pytest.FixtureRequest, name: str, *args: str) -> Path:
+    """A tiny-config workflow run (``snakemake *args``) made once per test session, in a
+    directory named ``name``: with pytest-xdist, the first worker to ask runs it (the others
+    wait on a file lock, then read it) in the session's shared temporary directory, so every
+    worker's tests read the same run. Its tests only read it or run commands that execute no
+    job there (a dry run, a refused config, ``--report``)."""
+    import fcntl
+    import json
+
     from tests.pipeline.test_workflow import snakemake
 
-    wd = tmp_path_factory.mktemp("wf_j2")
-    res = snakemake(wd, "-j2")
-    assert res.returncode == 0, res.stderr[-3000:]
+    factory = request.getfixturevalue("tmp_path_factory")
+    if not hasattr(request.config, "workerinput"):  # one process: no one to share with
+        wd = factory.mktemp(name)
+        res = snakemake(wd, *args)
+        assert res.returncode == 0, res.stderr[-3000:]
+        return wd
+    root = factory.getbasetemp().parent  # one per session, shared by its workers
+    wd, status = root / name, root / f"{name}.json"
+    with open(root / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
+        if not status.exists():
+            wd.mkdir()
+            res = snakemake(wd, *args)
+            done = {"returncode": res.returncode, "stderr": res.stderr[-3000:]}
+            status.write_text(json.dumps(done))
+        done = json.loads(status.read_text())
+    assert done["returncode"] == 0, done["stderr"]
     return wd
+
+
+@pytest.fixture(scope="session")
+def run_j2(request) -> Path:
+    """The whole workflow (LQG, UAV, report) on the tiny config with -j2, run once per session
+    (:func:`shared_run`)."""
+    return shared_run(request, "wf_j2", "-j2")
 
 
 #: the targets of the session's -j1 run (what the -j1 against -j2 comparisons read)
@@ -157,15 +206,10 @@ J1_TARGETS = ("lqg", "estimators", "results/decisions/lqg_regret.csv", "uav_coll
 
 
 @pytest.fixture(scope="session")
-def run_j1(tmp_path_factory) -> Path:
+def run_j1(request) -> Path:
     """The tiny config's LQG, estimator, LQG-decision and UAV simulations with -j1 (one worker),
     from an empty directory, once per session: compared with ``run_j2``."""
-    from tests.pipeline.test_workflow import snakemake
-
-    wd = tmp_path_factory.mktemp("wf_j1")
-    res = snakemake(wd, "-j1", *J1_TARGETS)
-    assert res.returncode == 0, res.stderr[-3000:]
-    return wd
+    return shared_run(request, "wf_j1", "-j1", *J1_TARGETS)
 
 
 @pytest.fixture(scope="session")

@@ -103,7 +103,7 @@ SAME = [
 ]
 
 
-def test_workflow_runs_through_slurm_like_locally_and_survives_scancel(cluster, run_j2, tmp_path):
+def test_workflow_runs_through_slurm_like_locally_and_survives_scancel(cluster, request, tmp_path):
     """docs/cluster.md's command on the tiny config's LQG and long-horizon tables (TARGETS):
     every job goes through SLURM (its records), the tables equal the local run's, the CPUs and
     memory of each job are the rule's and the profile's; a running job cancelled with scancel
@@ -144,7 +144,9 @@ def test_workflow_runs_through_slurm_like_locally_and_survives_scancel(cluster, 
     assert {r: n for r, n in planned.items() if r not in local} == done
     assert set(rec["JobState"]) == {"COMPLETED", "CANCELLED"} and (rec["Partition"] != "").all()
     assert local <= {"all", "lqg", "estimators", "uav", "decisions", "frontier", "horizon"}
-    # the results are the local run's, byte for byte
+    # the results are the local run's, byte for byte (asked for here, after the cluster run: under
+    # pytest-xdist another worker makes it meanwhile)
+    run_j2 = request.getfixturevalue("run_j2")
     for rel in SAME:
         assert (tmp_path / rel).read_bytes() == (run_j2 / rel).read_bytes(), rel
     # threads and memory that reached each job: the rule's, after the profile's set-threads
