@@ -131,10 +131,11 @@ test: lint $(PLUGIN_STAMP)
 
 # the quick tier (tests/conftest.py): every test but those that run the workflow for real
 # (workflow), on the local SLURM cluster (slurm) or compile numba kernels cold or for another
-# CPU (compile); no lint. make test runs them all.
+# CPU (compile); no lint. make test runs them all. On CORES pytest-xdist workers that take work
+# from each other (no test of this tier shares anything across processes).
 FAST := not workflow and not slurm and not compile
 test-fast: $(PLUGIN_STAMP)
-	$(BIN)/python -m pytest $(XDIST) --durations=10 -m "$(FAST)" tests $(PLUGIN)/tests
+	$(BIN)/python -m pytest -n $(CORES) --dist worksteal --durations=10 -m "$(FAST)" tests $(PLUGIN)/tests
 
 clean:
 	rm -rf results .snakemake
