@@ -267,6 +267,28 @@ def test_the_rule_file_check_can_fail(tmp_path):
     assert "FOO_JOBS" in _globals(a) and "FOO_JOBS" in _USED.findall(_strip_strings(b.read_text()))
 
 
+def _rsmhp_imports(paths) -> set[str]:
+    """The rsmhp modules the files ``paths`` import at their top level (``from``/``import``)."""
+    found: set[str] = set()
+    for path in paths:
+        found |= set(re.findall(r"^(?:from|import) (rsmhp[\w.]*)", path.read_text(), re.M))
+    return found
+
+
+def _loaded_by_importing(modules: set[str], heavy: tuple[str, ...]) -> str:
+    """Which of ``heavy`` a fresh Python process has loaded after importing ``modules`` (the
+    sorted list as printed)."""
+    import subprocess
+    import sys
+
+    code = (
+        f"import importlib, sys\nfor m in {sorted(modules)!r}: importlib.import_module(m)\n"
+        f"print(sorted(m for m in {heavy!r} if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    return out.stdout.strip()
+
+
 #: the UAV simulation rules: their scripts' imports leave scipy.stats and scipy.optimize out
 UAV_SIMULATION_SCRIPTS = (
     "uav_simulate", "uav_recording", "decisions_uav", "decisions_map_cell", "frontier_confirm",
@@ -279,20 +301,10 @@ def test_a_uav_simulation_job_does_not_import_scipy_stats_or_optimize():
     """What a UAV simulation job imports leaves scipy.stats and scipy.optimize unloaded, the
     example plugin included (each costs every job ~0.4 s at start; the planner's scipy
     oracle, the Sobol' direction numbers and Spearman's rho import them when first used)."""
-    import subprocess
-    import sys
-
-    modules = set()
-    for name in UAV_SIMULATION_SCRIPTS:
-        text = (ROOT / "workflow" / "scripts" / f"{name}.py").read_text()
-        modules |= set(re.findall(r"^(?:from|import) (rsmhp[\w.]*)", text, flags=re.M))
+    scripts = [ROOT / "workflow" / "scripts" / f"{name}.py" for name in UAV_SIMULATION_SCRIPTS]
+    modules = _rsmhp_imports(scripts)
     assert "rsmhp.studies.uav.simulate" in modules, modules
-    code = (
-        f"import importlib, sys\nfor m in {sorted(modules)!r}: importlib.import_module(m)\n"
-        "print(sorted(m for m in ('scipy.stats', 'scipy.optimize') if m in sys.modules))"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]", out.stdout + out.stderr
+    assert _loaded_by_importing(modules, ("scipy.stats", "scipy.optimize")) == "[]"
 
 
 def test_parsing_the_workflow_imports_no_plotting_or_scipy_submodule():
@@ -300,17 +312,13 @@ def test_parsing_the_workflow_imports_no_plotting_or_scipy_submodule():
     matplotlib, seaborn and scipy's stats, optimize and integrate unloaded (about 1.2 s a
     parse, paid by every snakemake command and by every job of a cluster run): a rule file
     takes its outputs' names from its study's package, not from its figure or section code."""
-    import subprocess
-    import sys
-
-    modules = set()
-    for path in [ROOT / "Snakefile", *sorted((ROOT / "workflow" / "rules").glob("*.smk"))]:
-        modules |= set(re.findall(r"^(?:from|import) (rsmhp[\w.]*)", path.read_text(), re.M))
+    rules = sorted((ROOT / "workflow" / "rules").glob("*.smk"))
+    modules = _rsmhp_imports([ROOT / "Snakefile", *rules])
     assert {"rsmhp.studies.frontier", "rsmhp.pipeline.config"} <= modules, modules
     heavy = ("matplotlib", "seaborn", "scipy.stats", "scipy.optimize", "scipy.integrate")
-    code = (
-        f"import importlib, sys\nfor m in {sorted(modules)!r}: importlib.import_module(m)\n"
-        f"print(sorted(m for m in {heavy!r} if m in sys.modules))"
-    )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
-    assert out.stdout.strip() == "[]", out.stdout + out.stderr
+    assert _loaded_by_importing(modules, heavy) == "[]"
+
+
+def test_the_import_check_can_fail():
+    """The check above sees a heavy module that an import brings along."""
+    assert _loaded_by_importing({"rsmhp.studies.frontier.figures"}, ("seaborn",)) == "['seaborn']"
