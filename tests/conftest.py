@@ -169,9 +169,6 @@ def shared_run(request: pytest.FixtureRequest, name: str, *args: str) -> Path:
     wait on a file lock, then read it) in the session's shared temporary directory, so every
     worker's tests read the same run. Its tests only read it or run commands that execute no
     job there (a dry run, a refused config, ``--report``)."""
-    import fcntl
-    import json
-
     from tests.pipeline.test_workflow import snakemake
 
     factory = request.getfixturevalue("tmp_path_factory")
@@ -181,17 +178,28 @@ def shared_run(request: pytest.FixtureRequest, name: str, *args: str) -> Path:
         assert res.returncode == 0, res.stderr[-3000:]
         return wd
     root = factory.getbasetemp().parent  # one per session, shared by its workers
-    wd, status = root / name, root / f"{name}.json"
+    done = made_once(root, name, lambda wd: snakemake(wd, *args))
+    assert done["returncode"] == 0, done["stderr"]
+    return root / name
+
+
+def made_once(root: Path, name: str, make) -> dict:
+    """``make(root / name)`` (a :class:`subprocess.CompletedProcess`) run by the first process
+    that asks, under an exclusive lock on ``root/<name>.lock``; every process, that one
+    included, gets its outcome from ``root/<name>.json``: ``{"returncode", "stderr"}`` (the
+    last 3000 characters)."""
+    import fcntl
+    import json
+
+    status = root / f"{name}.json"
     with open(root / f"{name}.lock", "w") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes
         if not status.exists():
-            wd.mkdir()
-            res = snakemake(wd, *args)
+            (root / name).mkdir()
+            res = make(root / name)
             done = {"returncode": res.returncode, "stderr": res.stderr[-3000:]}
             status.write_text(json.dumps(done))
-        done = json.loads(status.read_text())
-    assert done["returncode"] == 0, done["stderr"]
-    return wd
+        return json.loads(status.read_text())
 
 
 @pytest.fixture(scope="session")

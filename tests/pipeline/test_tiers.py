@@ -96,3 +96,55 @@ def test_the_tiers_name_registered_markers_and_the_fixtures_mark_their_tests(req
             assert "workflow" in marks, item.nodeid
         if item.nodeid.split("::")[0] in conftest.COMPILE_FILES:
             assert "compile" in marks, item.nodeid
+
+
+def _make_once_in_a_process(root: str, out: str) -> None:
+    """One pytest-xdist worker's share of the test below: ask for the run named "run"."""
+    import subprocess
+    import time
+
+    def make(wd: Path) -> subprocess.CompletedProcess:
+        with open(Path(root) / "made.log", "a") as fh:
+            fh.write(f"{wd.name}\n")
+        time.sleep(0.5)  # the other process asks meanwhile and waits on the lock
+        (wd / "result").write_text("42")
+        return subprocess.CompletedProcess([], 0, "", "made")
+
+    done = conftest.made_once(Path(root), "run", make)
+    Path(out).write_text(
+        f"{done['returncode']} {done['stderr']} {(Path(root) / 'run' / 'result').read_text()}"
+    )
+
+
+def test_a_shared_run_is_made_once_for_every_worker(tmp_path):
+    """Two processes ask for the same shared run at once: it is made once, and both get its
+    outcome and read its directory (conftest.made_once, behind run_j2 and run_j1)."""
+    import multiprocessing
+
+    ctx = multiprocessing.get_context("spawn")
+    outs = [tmp_path / f"out{i}" for i in range(2)]
+    procs = [
+        ctx.Process(target=_make_once_in_a_process, args=(str(tmp_path), str(o))) for o in outs
+    ]
+    for p in procs:
+        p.start()
+    for p in procs:
+        p.join(30)
+        assert p.exitcode == 0
+    assert (tmp_path / "made.log").read_text() == "run\n"  # made once
+    assert [o.read_text() for o in outs] == ["0 made 42"] * 2
+
+
+def test_a_failed_shared_run_fails_every_asker_without_a_second_attempt(tmp_path):
+    import subprocess
+
+    calls = []
+
+    def fail(wd: Path) -> subprocess.CompletedProcess:
+        calls.append(wd)
+        return subprocess.CompletedProcess([], 1, "", "x" * 5000 + "the reason")
+
+    first = conftest.made_once(tmp_path, "run", fail)
+    again = conftest.made_once(tmp_path, "run", fail)
+    assert first == again and first["returncode"] == 1 and len(calls) == 1
+    assert len(first["stderr"]) == 3000 and first["stderr"].endswith("the reason")
