@@ -4,6 +4,7 @@ small constructed tables and claims, the emulated environment, and one drill on 
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import os
@@ -155,6 +156,60 @@ def test_compare_claims():
     assert not missing[-1]["same verdict"]
 
 
+def _write_claims(path: Path, claims: list[Claim], config_hash: str | None = "abc") -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    data: dict = {"claims": [dataclasses.asdict(c) for c in claims]}
+    if config_hash is not None:
+        data["config sha256"] = config_hash
+    path.write_text(json.dumps(data))
+
+
+def test_a_drill_of_some_sections_compares_their_claims(tmp_path):
+    """Targets that make report sections but no report: the claims of those sections (the
+    native run's sections, the reference's same ids); refused when there is no section, the
+    native run lacks one, or the report changed a claim of one (a Holm family)."""
+    from types import SimpleNamespace
+
+    from rsmhp.report.portability import cli
+
+    nat, emu = tmp_path / "nat", tmp_path / "emu"
+    a, b, c = _claim("A", 1.0), _claim("B", 2.0, stat=True), _claim("C", 3.0)
+    _write_claims(tmp_path / "ref.json", [a, b, c])
+    _write_claims(nat / "results/paper/claims.json", [a, b, c])
+    _write_claims(nat / "results/report/one.json", [a, b], None)
+    _write_claims(nat / "results/report/two.json", [c], None)
+    _write_claims(emu / "results/report/one.json", [a, _claim("B", 2.5, stat=True)], None)
+    plan = SimpleNamespace(
+        reference=tmp_path / "ref.json",
+        native_dir=nat,
+        workdir=emu,
+        args=SimpleNamespace(target=["results/report/one.json"]),
+    )
+    got = cli._load_claims(plan)
+    assert got.sections == ["one"] and got.config_hash == "abc"
+    assert [x.id for x in got.reference] == [x.id for x in got.native] == ["A", "B"]
+    assert got.emulated[1].key.value == 2.5
+    # the whole report, when the emulated run made it
+    _write_claims(emu / "results/paper/claims.json", [a, b, c])
+    full = cli._load_claims(plan)
+    assert full.sections is None and [x.id for x in full.emulated] == ["A", "B", "C"]
+    (emu / "results/paper/claims.json").unlink()
+    # refusals
+    _write_claims(nat / "results/paper/claims.json", [a, _claim("B", 2.0, "inconclusive", True), c])
+    with pytest.raises(cli._Abort, match="the report changes the claims B of these sections"):
+        cli._load_claims(plan)
+    _write_claims(nat / "results/paper/claims.json", [a, b, c])
+    (nat / "results/report/one.json").unlink()
+    with pytest.raises(cli._Abort, match="the native run has no report section one"):
+        cli._load_claims(plan)
+    (emu / "results/report/one.json").unlink()
+    with pytest.raises(cli._Abort, match=r"make neither results/paper/claims\.json nor a report"):
+        cli._load_claims(plan)
+    _write_claims(tmp_path / "ref.json", [a, b, c], "def")
+    with pytest.raises(cli._Abort, match="config sha256 differs"):
+        cli._load_claims(plan)
+
+
 # --- the emulation -------------------------------------------------------------------------
 
 
@@ -291,13 +346,24 @@ def _content(path: Path, aside: list[str]) -> str:
     return df.to_csv(index=False)
 
 
+#: the drill's targets: two studies' report sections (the LQG study's bitwise claims, the UAV
+#: closed loop's statistical ones) and a long-horizon table (14 jobs of the tiny config). Every
+#: kernel is still compiled for the generic CPU; the whole report's drill is `make portability`'s
+#: default, its comparison of claims files tested above on constructed claims
+DRILL_TARGETS = [
+    "results/report/lqg.json",
+    "results/report/uav.json",
+    "results/horizon/uav/paper_H2_approx.csv",
+]
+
+
 @pytest.mark.workflow
 @pytest.mark.compile  # every kernel compiled for the generic CPU in the emulated run
 def test_drill_on_the_tiny_config(run_j2, tmp_path):
-    """The emulated tiny run: numba compiled every kernel for the generic CPU (in the warm-up,
-    none in a job), OpenBLAS ran on another core type (both recorded inside the run), every
-    verdict is the native run's, the native results are untouched, and each table is
-    classified as its content says."""
+    """The emulated run of two studies of the tiny config (DRILL_TARGETS): numba compiled every
+    kernel for the generic CPU (in the warm-up, none in a job), OpenBLAS ran on another core
+    type (recorded inside the run), every verdict of those studies is the native run's, the
+    native results are untouched, and each table is classified as its content says."""
     before = _files(run_j2 / "results")
     emulated = tmp_path / "emulated"
     t0 = time.perf_counter()
@@ -318,6 +384,8 @@ def test_drill_on_the_tiny_config(run_j2, tmp_path):
             "--output",
             str(tmp_path / "drill"),
             "--quiet",
+            "--target",
+            *DRILL_TARGETS,
         ],
         capture_output=True,
         text=True,
@@ -329,6 +397,7 @@ def test_drill_on_the_tiny_config(run_j2, tmp_path):
     drill = json.loads((tmp_path / "drill.json").read_text())
     text = (tmp_path / "drill.md").read_text()
     assert text.startswith("# Portability drill: PASS") and text in res.stdout
+    assert drill["sections"] == ["lqg", "uav"] and "only the claims of the report" in text
     emu = drill["emulation"]
     inside = emu["inside the emulated run"]
     assert emu["effective"] and emu["problems"] == [], emu["problems"]
@@ -338,7 +407,7 @@ def test_drill_on_the_tiny_config(run_j2, tmp_path):
     assert inside["numba target CPUs"] == ["generic"] and inside["numba features"] == ["(none)"]
     assert len(inside["kernels"]) >= 3
     assert all(k["compiled"] >= 1 for k in inside["kernels"].values())
-    assert {"uav_simulate", "decisions_uav"} <= set(inside["rules with compiled kernels"])
+    assert {"uav_simulate", "horizon_uav"} <= set(inside["rules with compiled kernels"])
     assert emu["emulated numba cache"] and all(
         v == ["generic"] for v in emu["emulated numba cache"].values()
     )
@@ -346,7 +415,7 @@ def test_drill_on_the_tiny_config(run_j2, tmp_path):
     # ... by the warm-up, from the copy's src/ that the jobs import (numba's cache is keyed on
     # the source file): no job of the run compiled a kernel, each loaded what it used
     jobs = [r for r in pt.read_records(emulated / ".drill/records") if r.get("rule")]
-    assert {"uav_simulate", "horizon_uav"} <= {r["rule"] for r in jobs}
+    assert {"uav_simulate", "horizon_uav", "lqg_convergence"} <= {r["rule"] for r in jobs}
     compiled = [
         (r["rule"], name)
         for r in jobs
@@ -354,39 +423,43 @@ def test_drill_on_the_tiny_config(run_j2, tmp_path):
         if k["compiled"]
     ]
     assert not compiled, compiled
-    # OpenBLAS: the emulated core type inside every process and in the run's provenance
+    # OpenBLAS: the emulated core type inside every process (the run made no provenance.json:
+    # the report rule writes it)
     assert inside["openblas core types"] == ["Nehalem"]
     assert "Nehalem" not in emu["native"]["openblas"]
-    assert "Nehalem" in emu["emulated run blas (provenance.json)"]
+    assert emu["emulated run blas (provenance.json)"] is None
     assert "Nehalem" not in emu["native run blas (provenance.json)"]
     assert inside["numpy SIMD extensions"] == []
-    # claims: every verdict the same, both runs pass verify
+    # claims: those of the two sections, every verdict the same, both runs pass verify
     assert drill["verify native"] == drill["verify emulated"] == "PASS"
-    assert drill["claims"] and all(r["same verdict"] for r in drill["claims"])
-    # tables: all of both runs, each classified as its content (timing and code aside) says
+    ids = [r["id"] for r in drill["claims"]]
+    assert ids == [c["id"] for s in ("lqg", "uav") for c in _section(run_j2, s)["claims"]]
+    assert all(r["same verdict"] for r in drill["claims"])
+    assert {r["reproducible"] for r in drill["claims"]} == {"bitwise", "statistical"}
+    # tables: the emulated run's, each classified as its content (timing and code aside) says
     tables = {t["table"]: t for t in drill["tables"]}
-    native_tables = {
-        str(p.relative_to(run_j2 / "results"))
-        for p in (run_j2 / "results").rglob("*")
+    emulated_tables = {
+        str(p.relative_to(emulated / "results"))
+        for p in (emulated / "results").rglob("*")
         if p.suffix in (".csv", ".parquet")
     }
-    assert set(tables) == native_tables
-    # every table is made by target report (the equal-compute study's too) in both runs
-    assert not [n for n, t in tables.items() if t["status"] == "missing (emulated)"]
-    assert "plan_ms" in tables["frontier/explore_summary.csv"]["set aside"]
+    assert set(tables) == emulated_tables
+    assert {"lqg/convergence.csv", "uav/runs.csv", "horizon/uav/paper_H2_approx.csv"} <= set(tables)
+    assert not [n for n, t in tables.items() if t["status"].startswith("missing")]
     for name, t in tables.items():
         same = _content(run_j2 / "results" / name, t["set aside"]) == _content(
             emulated / "results" / name, t["set aside"]
         )
         assert t["status"] == ("identical" if same else "differs"), name
         assert bool(t["columns"]) == (not same), name
-    assert "uav/runs.csv" in tables and tables["uav/runs.csv"]["set aside"] == [
-        "plan_seconds",
-        "code",
-    ]
+    assert tables["uav/runs.csv"]["set aside"] == ["plan_seconds", "code"]
     # the native results were only read
     assert _files(run_j2 / "results") == before
     print(
         f"tiny drill: {seconds:.0f} s; {sum(t['status'] == 'identical' for t in tables.values())}"
         f" of {len(tables)} tables identical"
     )
+
+
+def _section(run: Path, name: str) -> dict:
+    return json.loads((run / "results/report" / f"{name}.json").read_text())

@@ -22,7 +22,7 @@ from typing import Any
 
 import numpy as np
 
-from rsmhp.report.portability.compare import compare_claims, compare_results
+from rsmhp.report.portability.compare import compare_claims, compare_results, section_claims
 from rsmhp.report.portability.emulation import (
     COMPONENTS,
     DEFAULT_CORETYPE,
@@ -110,7 +110,9 @@ def _add_run_options(p: argparse.ArgumentParser) -> None:
         default=["report", "frontier_reference"],
         help="snakemake targets of both runs (default: report and frontier_reference, what "
         "make verify and make publish need: every table and claim, the comparison's "
-        "reference; `all` adds the recordings)",
+        "reference; `all` adds the recordings). Targets without the report, e.g. "
+        "results/report/uav.json, drill those studies only: the claims of the report "
+        "sections the emulated run made and its tables (the native run makes the report too)",
     )
 
 
@@ -261,12 +263,14 @@ def _run_workflows(plan: _Plan, envs: _Environments) -> None:
     args = plan.args
     if not args.no_native_run:
         print("portability: completing the native run", flush=True)
+        # the native run is make verify's: its report too, whatever the emulated run's targets
+        full = {"report", "all"} & set(args.target)
         code = _snakemake(
             plan.native_dir,
             plan.checkout / "Snakefile",
             plan.configfiles,
             args.cores,
-            args.target,
+            [*args.target, *([] if full else ["report"])],
             envs.native,
             None,
             args.quiet,
@@ -297,15 +301,38 @@ def _run_workflows(plan: _Plan, envs: _Environments) -> None:
         raise _Abort(f"the emulated run failed (log {log})")
 
 
-def _load_claims(plan: _Plan) -> tuple[list[Any], list[Any], list[Any], str]:
-    """(reference, native, emulated claims, their configuration's sha256); all three must be
-    of the same configuration."""
+@dataclass
+class _Claims:
+    """The claims compared: the reference's, the native and the emulated run's, their
+    configuration's sha256, and the report sections they come from (None: the whole report,
+    ``results/paper/claims.json``; else the sections the emulated run's targets made)."""
+
+    reference: list[Any]
+    native: list[Any]
+    emulated: list[Any]
+    config_hash: str
+    sections: list[str] | None
+
+
+def _load_claims(plan: _Plan) -> _Claims:
+    """The claims of the three runs, all of the same configuration. When the emulated run made
+    the report, every claim of the three ``claims.json``; when its targets made only some report
+    sections (``results/report/<study>.json``), the claims of those sections, from the
+    same sections of the native run, and the reference's claims of the same ids. A claim the
+    report changes (a Holm family's adjusted p-value) cannot be checked from its section: such
+    a section is refused, naming the claims."""
     from rsmhp.report.verify import load_claims
 
     try:
         ref_claims, ref_hash = load_claims(plan.reference)
         nat_claims, nat_hash = load_claims(plan.native_dir / "results/paper/claims.json")
-        emu_claims, emu_hash = load_claims(plan.workdir / "results/paper/claims.json")
+        if (plan.workdir / "results/paper/claims.json").is_file():
+            emu_claims, emu_hash = load_claims(plan.workdir / "results/paper/claims.json")
+            sections = None
+        else:
+            emu_by = section_claims(plan.workdir / "results/report")
+            nat_by = section_claims(plan.native_dir / "results/report")
+            sections, emu_hash = sorted(emu_by), nat_hash
     except ValueError as exc:
         raise _Abort(str(exc)) from exc
     if len({ref_hash, nat_hash, emu_hash}) != 1:
@@ -313,7 +340,37 @@ def _load_claims(plan: _Plan) -> tuple[list[Any], list[Any], list[Any], str]:
             f"config sha256 differs (reference {ref_hash}, native {nat_hash}, "
             f"emulated {emu_hash}): compare runs of the same configuration"
         )
-    return ref_claims, nat_claims, emu_claims, ref_hash
+    if sections is None:
+        return _Claims(ref_claims, nat_claims, emu_claims, ref_hash, None)
+    if not sections:
+        raise _Abort(
+            f"the targets {' '.join(plan.args.target)} make neither results/paper/claims.json "
+            "nor a report section (results/report/<study>.json): no claim to compare"
+        )
+    missing = [s for s in sections if s not in nat_by]
+    if missing:
+        raise _Abort(f"the native run has no report section {', '.join(missing)}")
+    nat_claims = [c for s in sections for c in nat_by[s]]
+    emu_claims = [c for s in sections for c in emu_by[s]]
+    reported = {c.id: c for c in load_claims(plan.native_dir / "results/paper/claims.json")[0]}
+    changed = [c.id for c in nat_claims if c.id in reported and not _same(c, reported[c.id])]
+    if changed:
+        raise _Abort(
+            f"the report changes the claims {', '.join(changed)} of these sections (a Holm "
+            "family's adjusted p-values): drill them with --target report"
+        )
+    ids = {c.id for c in [*nat_claims, *emu_claims]}
+    scoped = [c for c in ref_claims if c.id in ids]
+    return _Claims(scoped, nat_claims, emu_claims, ref_hash, sections)
+
+
+def _same(a: Any, b: Any) -> bool:
+    """Whether two claims hold the same fields (NaN equal to NaN, as in their JSON)."""
+    from dataclasses import asdict
+
+    return json.dumps(asdict(a), sort_keys=True, default=str) == json.dumps(
+        asdict(b), sort_keys=True, default=str
+    )
 
 
 def _summarise(plan: _Plan, envs: _Environments) -> dict[str, Any]:
@@ -332,10 +389,14 @@ def _summarise(plan: _Plan, envs: _Environments) -> dict[str, Any]:
 def _assemble(plan: _Plan, envs: _Environments) -> dict[str, Any]:
     """The drill: the emulation as measured, every claim and table compared, and the result
     (``PASS`` when both runs pass verify with the same verdicts)."""
-    ref_claims, nat_claims, emu_claims, config_hash = _load_claims(plan)
+    loaded = _load_claims(plan)
     emulation = _summarise(plan, envs)
-    claims = compare_claims(ref_claims, nat_claims, emu_claims)
-    tables = compare_results(plan.native_dir / "results", plan.workdir / "results")
+    claims = compare_claims(loaded.reference, loaded.native, loaded.emulated)
+    tables = compare_results(
+        plan.native_dir / "results",
+        plan.workdir / "results",
+        emulated_only=loaded.sections is not None,
+    )
     verify_native = all(r["verify (native)"] == "ok" for r in claims)
     verify_emulated = all(r["verify (emulated)"] == "ok" for r in claims)
     agree = all(r["same verdict"] for r in claims)
@@ -348,7 +409,9 @@ def _assemble(plan: _Plan, envs: _Environments) -> dict[str, Any]:
         "native": str(plan.native_dir),
         "emulated": str(plan.workdir) + (" (temporary, removed)" if removed else ""),
         "reference": str(plan.reference),
-        "config sha256": config_hash,
+        "config sha256": loaded.config_hash,
+        "targets": list(plan.args.target),
+        "sections": loaded.sections,
         "env": envs.shown,
         "verify native": "PASS" if verify_native else "FAIL",
         "verify emulated": "PASS" if verify_emulated else "FAIL",

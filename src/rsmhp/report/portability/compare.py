@@ -5,6 +5,7 @@ differences) and every claim of the reference, the native and the emulated run
 
 from __future__ import annotations
 
+import json
 import math
 import os
 import re
@@ -23,6 +24,7 @@ __all__ = [
     "expected_class",
     "is_timing_column",
     "read_table",
+    "section_claims",
 ]
 
 #: the code stamp column of every table (rsmhp.pipeline.io.CODE_COLUMN; not imported, so this module
@@ -161,15 +163,19 @@ def _stamps(df: pd.DataFrame) -> set[str]:
     return set(df[CODE_COLUMN].dropna().astype(str)) if CODE_COLUMN in df else set()
 
 
-def compare_results(native: str | os.PathLike, emulated: str | os.PathLike) -> list[dict[str, Any]]:
+def compare_results(
+    native: str | os.PathLike, emulated: str | os.PathLike, emulated_only: bool = False
+) -> list[dict[str, Any]]:
     """One entry per CSV/Parquet table under either ``results`` directory (``portability/``
     aside), in path order: :func:`compare_frames` of the two versions with the table's
     ``table`` path, ``expected`` class (:func:`expected_class`) and, when the code stamps of
     the two differ (other code made them), ``code stamps``; ``status`` ``missing (native)``
-    or ``missing (emulated)`` when only one run has it."""
+    or ``missing (emulated)`` when only one run has it. ``emulated_only``: only the tables of
+    the emulated run (a drill of some targets: the native run's others are not in it)."""
     native, emulated = Path(native), Path(emulated)
     out = []
-    for rel in sorted(_tables(native) | _tables(emulated)):
+    names = _tables(emulated) if emulated_only else _tables(native) | _tables(emulated)
+    for rel in sorted(names):
         entry: dict[str, Any] = {"table": rel, "expected": expected_class(rel)}
         if not (native / rel).is_file() or not (emulated / rel).is_file():
             side = "native" if not (native / rel).is_file() else "emulated"
@@ -180,6 +186,23 @@ def compare_results(native: str | os.PathLike, emulated: str | os.PathLike) -> l
         if _stamps(a) != _stamps(b):
             entry["code stamps"] = {"native": sorted(_stamps(a)), "emulated": sorted(_stamps(b))}
         out.append(entry)
+    return out
+
+
+def section_claims(report_dir: str | os.PathLike) -> dict[str, list[Any]]:
+    """The claims of every report section a run made, ``{section: [Claim, ...]}`` in name
+    order, from ``<report_dir>/<section>.json`` (``results/report/``, each study's summary
+    rule writes one; the report rule gathers them into ``results/paper/claims.json``). A
+    clear ``ValueError`` names a section file that is not of that form."""
+    from rsmhp.report.ledger import Claim
+
+    out: dict[str, list[Any]] = {}
+    for path in sorted(Path(report_dir).glob("*.json")):
+        try:
+            data = json.loads(path.read_text(encoding="utf-8"))
+            out[path.stem] = [Claim.from_dict(c) for c in data["claims"]]
+        except (ValueError, TypeError, KeyError) as exc:
+            raise ValueError(f"{path}: not a report section with a list 'claims' ({exc})") from exc
     return out
 
 

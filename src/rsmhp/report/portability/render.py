@@ -102,9 +102,14 @@ def _openblas_row(emu: Mapping[str, Any]) -> list[str]:
         or ", ".join(nat["openblas"]),
         _emulated(emu, "openblas", ", ".join(inside["openblas core types"]) or "-"),
         "threadpoolctl inside the run; provenance.json: native "
-        f"`{emu['native run blas (provenance.json)']}`, emulated "
-        f"`{emu['emulated run blas (provenance.json)']}`",
+        f"{_blas_line(emu['native run blas (provenance.json)'])}, emulated "
+        f"{_blas_line(emu['emulated run blas (provenance.json)'])}",
     ]
+
+
+def _blas_line(blas: str | None) -> str:
+    """A run's provenance ``blas`` line, or why there is none (the report rule writes it)."""
+    return f"`{blas}`" if blas else "none (the run made no report)"
 
 
 def _numpy_row(emu: Mapping[str, Any]) -> list[str]:
@@ -131,12 +136,26 @@ def _head(drill: Mapping[str, Any]) -> list[str]:
         "",
         f"Native run `{drill['native']}`, emulated run `{drill['emulated']}`, reference "
         f"`{drill['reference']}`, config sha256 `{drill['config sha256']}`. "
+        + _scope(drill)
         + (
             "The emulation took effect (below, as measured)."
             if emu["effective"]
             else "**The emulation did not take effect:** " + "; ".join(emu["problems"]) + "."
         ),
     ]
+
+
+def _scope(drill: Mapping[str, Any]) -> str:
+    """What the drill covers when its targets are not the whole report (else nothing)."""
+    sections = drill.get("sections")
+    if sections is None:
+        return ""
+    return (
+        f"Targets `{' '.join(drill.get('targets', []))}`: only the claims of the report "
+        f"sections {', '.join(f'`{s}`' for s in sections)} and the emulated run's "
+        f"{len(drill['tables'])} tables are compared (the configuration's hash is the native "
+        "run's report's; the emulated run, with the same config files, made no report). "
+    )
 
 
 def _emulation_part(drill: Mapping[str, Any]) -> list[str]:
