@@ -22,7 +22,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from tests.pipeline.test_workflow import CSVS, ROOT, TINY
+from tests.pipeline.test_workflow import ROOT, TINY
 
 pytestmark = pytest.mark.slurm
 
@@ -81,30 +81,27 @@ def _planned(out: str) -> dict[str, int]:
     }
 
 
-#: the targets run through SLURM, the tables the test checks and nothing else (10 jobs of the
-#: tiny config; each SLURM job starts its own snakemake): the LQG case study's tables
-#: (lqg_convergence, the job cancelled; lqg_nbo_error, lqg_linear_cost, lqg_summary) and the
-#: long-horizon study's UAV approximation tables (three horizon_uav jobs and their merge) and
-#: LQG tables (horizon_lqg_estimators: 2 threads and 3000 MB of its own; horizon_lqg_regret).
-#: Targets `lqg horizon` added their figures, recordings, the closed-loop and optimiser jobs
-#: (25 jobs), which checked nothing more of SLURM at 2.5 times the time
+#: the targets run through SLURM, the smallest set that still shows each thing the test is for
+#: (3 jobs of the tiny config; each SLURM job starts its own snakemake): lqg_convergence (8
+#: threads in the profile, capped by max-threads; the job cancelled and retried),
+#: horizon_lqg_estimators (2 threads and 3000 MB of the rule's own) and one horizon_uav job
+#: (a job loading the compiled kernels). The first version's 25 jobs (targets `lqg horizon`)
+#: and the second's 10 (the LQG summary, the long-horizon merges) checked nothing more of SLURM
 TARGETS = [
-    "results/lqg/summary.csv",
+    "results/lqg/convergence.csv",
     "results/horizon/lqg_estimators.csv",
-    "results/horizon/lqg_regret.csv",
-    "results/horizon/uav/paper_H2_approx.csv",
+    "results/horizon/uav/chunks/paper_H2/0_approx.csv",
 ]
 #: tables compared byte for byte with the local run (no timing column)
 SAME = [
-    *CSVS,
-    "results/horizon/lqg_regret.csv",
-    "results/horizon/uav/paper_H2_approx.csv",
-    "results/horizon/uav/paper_H4_approx.csv",
+    "results/lqg/convergence.csv",
+    "results/horizon/uav/chunks/paper_H2/0_approx.csv",
+    "results/horizon/uav/chunks/paper_H2/0_regret.csv",
 ]
 
 
 def test_workflow_runs_through_slurm_like_locally_and_survives_scancel(cluster, request, tmp_path):
-    """docs/cluster.md's command on the tiny config's LQG and long-horizon tables (TARGETS):
+    """docs/cluster.md's command on three jobs of the tiny config (TARGETS):
     every job goes through SLURM (its records), the tables equal the local run's, the CPUs and
     memory of each job are the rule's and the profile's; a running job cancelled with scancel
     is retried (`retries: 1`) and the run completes."""
