@@ -210,7 +210,15 @@ def run_j2(request) -> Path:
 
 
 #: the targets of the session's -j1 run (what the -j1 against -j2 comparisons read)
-J1_TARGETS = ("lqg", "estimators", "results/decisions/lqg_regret.csv", "uav_collect")
+#: the tables the -j1 comparisons read (not the studies' figures and recordings: no worker
+#: count reaches those but through these tables)
+J1_TARGETS = (
+    "results/lqg/summary.csv",
+    "results/lqg/nbo_error_summary.csv",
+    "results/estimators/summary.csv",
+    "results/decisions/lqg_regret.csv",
+    "uav_collect",
+)
 
 
 @pytest.fixture(scope="session")

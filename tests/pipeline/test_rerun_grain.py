@@ -18,7 +18,8 @@ from pathlib import Path
 
 import pytest
 
-from tests.pipeline.test_workflow import COPY_TRIGGERS, ROOT, TINY, copy_workflow_and_run
+from tests.pipeline.test_workflow import ROOT, TINY
+from tests.pipeline.test_workflow_reruns import COPY_TRIGGERS, copy_workflow_and_run
 
 #: reads (a copy of) the session's tiny run; its own snakemake calls are dry runs
 pytestmark = pytest.mark.workflow
