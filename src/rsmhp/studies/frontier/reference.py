@@ -23,6 +23,7 @@ Files (``make publish`` copies ``results/frontier/reference/`` to ``paper/refere
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import os
@@ -68,17 +69,27 @@ def scenario_fingerprint(code: str, config: Mapping[str, Any]) -> dict[str, Any]
     return {"code": str(code), "config": dict(config), "config_sha256": config_sha256(config)}
 
 
+@functools.cache
+def _distributions() -> Mapping[str, list[str]]:
+    """importlib.metadata.packages_distributions(), scanned once per process (about 0.5 s:
+    it reads every installed distribution's records; the workflow asks twice when parsed)."""
+    import importlib.metadata
+
+    return importlib.metadata.packages_distributions()
+
+
 def method_sources(names: Sequence[str]) -> dict[str, str]:
     """Per method name, the distribution that provides its family and the sha256 of the
     family's module source (``"rsmhp-plugin-example lhs 3f2a..."``): the new methods' own
     code, which may live outside this repository (a plugin package), so that an edit of it
     reruns the comparison."""
-    import importlib.metadata
     import inspect
 
     from rsmhp.models.uav import methods
 
-    dists = importlib.metadata.packages_distributions()
+    if not names:  # no new method (the default): no scan of the installed distributions
+        return {}
+    dists = _distributions()
     out = {}
     for name in names:
         cls = type(methods.from_name(name))
