@@ -110,7 +110,7 @@ def _start_order(item: pytest.Item) -> int:
     """When ``item`` starts (lower first, collection order within). Under pytest-xdist (make
     test: ``--dist loadfile --no-loadscope-reorder``, a test file's tests on one worker, files
     in the order of their first test here): the file of a test that makes the shared tiny run
-    (:func:`shared_run`), then the SLURM run's (it asks for that run only at its end) and those
+    (:func:`shared_run`), then the SLURM run's (with a local run of its own) and those
     of slow tests that need no shared run, then the portability drill's (the shared run and
     its own emulated one), then the rest. So the longest work starts first on both workers
     and no worker waits long for the shared run. Without xdist, only the order changes."""

@@ -4,7 +4,7 @@ profile workflow/profiles/slurm, with the commands of docs/cluster.md.
 Marker ``slurm``: run on the project's machines (root on Debian; CI brings the cluster up from
 the distribution's packages), skipped with the reason elsewhere. Oracles: SLURM's own record
 of every finished job (/var/log/slurm/jobcomp.tsv, written by slurmctld's jobcomp/script hook,
-and `scontrol`), the local -j2 run of the same config (byte-identical tables apart from
+and `scontrol`), a local -j2 run of the same targets (byte-identical tables apart from
 timing columns) and the profile's and rules' declared threads and memory.
 """
 
@@ -22,7 +22,7 @@ import pandas as pd
 import pytest
 import yaml
 
-from tests.pipeline.test_workflow import ROOT, TINY
+from tests.pipeline.test_workflow import ROOT, TINY, snakemake
 
 pytestmark = pytest.mark.slurm
 
@@ -100,7 +100,7 @@ SAME = [
 ]
 
 
-def test_workflow_runs_through_slurm_like_locally_and_survives_scancel(cluster, request, tmp_path):
+def test_workflow_runs_through_slurm_like_locally_and_survives_scancel(cluster, tmp_path):
     """docs/cluster.md's command on three jobs of the tiny config (TARGETS):
     every job goes through SLURM (its records), the tables equal the local run's, the CPUs and
     memory of each job are the rule's and the profile's; a running job cancelled with scancel
@@ -141,11 +141,13 @@ def test_workflow_runs_through_slurm_like_locally_and_survives_scancel(cluster, 
     assert {r: n for r, n in planned.items() if r not in local} == done
     assert set(rec["JobState"]) == {"COMPLETED", "CANCELLED"} and (rec["Partition"] != "").all()
     assert local <= {"all", "lqg", "estimators", "uav", "decisions", "frontier", "horizon"}
-    # the results are the local run's, byte for byte (asked for here, after the cluster run: under
-    # pytest-xdist another worker makes it meanwhile)
-    run_j2 = request.getfixturevalue("run_j2")
+    # the results are a local run's, byte for byte: the same targets with -j2 in a directory of
+    # their own (3 jobs; not the session's shared run, which this worker would wait for)
+    local_run = tmp_path / "local"
+    res = snakemake(local_run, "-j2", *TARGETS)
+    assert res.returncode == 0, res.stderr[-3000:]
     for rel in SAME:
-        assert (tmp_path / rel).read_bytes() == (run_j2 / rel).read_bytes(), rel
+        assert (tmp_path / rel).read_bytes() == (local_run / rel).read_bytes(), rel
     # threads and memory that reached each job: the rule's, after the profile's set-threads
     # (capped by max-threads = the node's CPUs) and set-resources / default-resources
     profile = yaml.safe_load((PROFILE / "config.yaml").read_text())
