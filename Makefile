@@ -126,8 +126,14 @@ $(PLUGIN_STAMP): $(STAMP) $(PLUGIN)/pyproject.toml
 # tiny runs are made once and shared by the workers (tests/conftest.py). Serially:
 # $(BIN)/pytest tests
 XDIST := -n $(CORES) --dist loadfile --no-loadscope-reorder
-test: lint $(PLUGIN_STAMP)
-	$(BIN)/python -m pytest $(XDIST) --durations=25 tests $(PLUGIN)/tests
+# lint runs beside the tests (one process, about 20 s), its output printed after theirs; make
+# test fails if either fails (pytest's own exit status otherwise, 5 when no test ran)
+test: $(PLUGIN_STAMP)
+	@log=$$(mktemp); $(MAKE) --no-print-directory lint > $$log 2>&1 & lint=$$!; \
+	$(BIN)/python -m pytest $(XDIST) --durations=25 tests $(PLUGIN)/tests; rc=$$?; \
+	wait $$lint; lint_rc=$$?; echo "--- make lint (beside the tests)"; cat $$log; rm -f $$log; \
+	if [ $$lint_rc -ne 0 ]; then echo "make test: lint failed (above)" >&2; exit 1; fi; \
+	exit $$rc
 
 # the quick tier (tests/conftest.py): every test but those that run the workflow for real
 # (workflow), on the local SLURM cluster (slurm) or compile numba kernels cold or for another

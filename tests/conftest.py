@@ -112,8 +112,10 @@ def _start_order(item: pytest.Item) -> int:
     in the order of their first test here): the file of a test that makes the shared tiny run
     (:func:`shared_run`), then the SLURM run's (with a local run of its own) and those
     of slow tests that need no shared run, then the portability drill's (the shared run and
-    its own emulated one), then the rest. So the longest work starts first on both workers
-    and no worker waits long for the shared run. Without xdist, only the order changes."""
+    its own emulated one), then the other files of tests that read the shared run (runs on
+    copies of it), then the rest. So the longest work starts first on both workers, no worker
+    waits long for the shared run, and quick tests fill the end on both. Without xdist, only
+    the order changes."""
     uses = WORKFLOW_FIXTURES & set(getattr(item, "fixturenames", ()))
     marks = {m.name for m in item.iter_markers()}
     if "slurm" in marks:
@@ -124,7 +126,9 @@ def _start_order(item: pytest.Item) -> int:
         return 2
     if item.name == "test_drill_on_the_tiny_config":
         return 3
-    return 4
+    if uses:  # the other tests of the shared run, before the quick ones fill the end
+        return 4
+    return 5
 
 
 def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
