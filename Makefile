@@ -127,7 +127,8 @@ $(PLUGIN_STAMP): $(STAMP) $(PLUGIN)/pyproject.toml
 # $(BIN)/pytest tests
 XDIST := -n $(CORES) --dist loadfile --no-loadscope-reorder
 # lint runs beside the tests (one process, about 20 s), its output printed after theirs; make
-# test fails if either fails (pytest's own exit status otherwise, 5 when no test ran)
+# test fails if either fails (make then exits 2 whatever pytest's status, 5 when no test ran
+# included: .ci/run fails on any non-zero status)
 test: $(PLUGIN_STAMP)
 	@log=$$(mktemp); $(MAKE) --no-print-directory lint > $$log 2>&1 & lint=$$!; \
 	$(BIN)/python -m pytest $(XDIST) --durations=25 tests $(PLUGIN)/tests; rc=$$?; \

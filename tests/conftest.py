@@ -213,9 +213,8 @@ def run_j2(request) -> Path:
     return shared_run(request, "wf_j2", "-j2")
 
 
-#: the targets of the session's -j1 run (what the -j1 against -j2 comparisons read)
-#: the tables the -j1 comparisons read (not the studies' figures and recordings: no worker
-#: count reaches those but through these tables)
+#: the targets of the session's -j1 run: the tables the -j1 comparisons read (not the studies'
+#: figures and recordings: no worker count reaches those but through these tables)
 J1_TARGETS = (
     "results/lqg/summary.csv",
     "results/lqg/nbo_error_summary.csv",

@@ -189,6 +189,7 @@ def test_a_drill_of_some_sections_compares_their_claims(tmp_path):
     assert got.sections == ["one"] and got.config_hash == "abc"
     assert [x.id for x in got.reference] == [x.id for x in got.native] == ["A", "B"]
     assert got.emulated[1].key.value == 2.5
+    assert got.n_statistical == 1  # the whole reference's, as make verify counts them
     # the whole report, when the emulated run made it
     _write_claims(emu / "results/paper/claims.json", [a, b, c])
     full = cli._load_claims(plan)

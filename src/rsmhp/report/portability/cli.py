@@ -312,6 +312,8 @@ class _Claims:
     emulated: list[Any]
     config_hash: str
     sections: list[str] | None
+    #: the whole reference's statistical claims (make verify's tolerance counts them all)
+    n_statistical: int | None = None
 
 
 def _load_claims(plan: _Plan) -> _Claims:
@@ -361,7 +363,8 @@ def _load_claims(plan: _Plan) -> _Claims:
         )
     ids = {c.id for c in [*nat_claims, *emu_claims]}
     scoped = [c for c in ref_claims if c.id in ids]
-    return _Claims(scoped, nat_claims, emu_claims, ref_hash, sections)
+    n_stat = sum(c.key.reproducible == "statistical" for c in ref_claims)
+    return _Claims(scoped, nat_claims, emu_claims, ref_hash, sections, n_stat)
 
 
 def _same(a: Any, b: Any) -> bool:
@@ -391,7 +394,7 @@ def _assemble(plan: _Plan, envs: _Environments) -> dict[str, Any]:
     (``PASS`` when both runs pass verify with the same verdicts)."""
     loaded = _load_claims(plan)
     emulation = _summarise(plan, envs)
-    claims = compare_claims(loaded.reference, loaded.native, loaded.emulated)
+    claims = compare_claims(loaded.reference, loaded.native, loaded.emulated, loaded.n_statistical)
     tables = compare_results(
         plan.native_dir / "results",
         plan.workdir / "results",

@@ -207,17 +207,22 @@ def section_claims(report_dir: str | os.PathLike) -> dict[str, list[Any]]:
 
 
 def compare_claims(
-    reference: Sequence[Any], native: Sequence[Any], emulated: Sequence[Any]
+    reference: Sequence[Any],
+    native: Sequence[Any],
+    emulated: Sequence[Any],
+    n_statistical: int | None = None,
 ) -> list[dict[str, Any]]:
     """One row per claim (reference order, then claims only in a run): the key number of
     the reference, the native and the emulated run, emulated minus native (absolute and
     relative), whether it is bitwise equal, ``make verify``'s status of each run against
-    the reference (:func:`rsmhp.report.verify.compare`) and whether all three verdicts are the
-    same. Claims are :class:`rsmhp.report.ledger.Claim`."""
+    the reference (:func:`rsmhp.report.verify.compare`; ``n_statistical``, the whole
+    reference's statistical claims when only some are compared, so the tolerance is
+    ``make verify``'s) and whether all three verdicts are the same. Claims are
+    :class:`rsmhp.report.ledger.Claim`."""
     from rsmhp.report.verify import compare
 
-    ver_native = compare(reference, native).set_index("id")
-    ver_emul = compare(reference, emulated).set_index("id")
+    ver_native = compare(reference, native, n_statistical).set_index("id")
+    ver_emul = compare(reference, emulated, n_statistical).set_index("id")
     by = [{c.id: c for c in claims} for claims in (reference, native, emulated)]
     ids = list(dict.fromkeys([*by[0], *by[1], *by[2]]))
     return [_claim_row(cid, *(b.get(cid) for b in by), ver_native, ver_emul) for cid in ids]
