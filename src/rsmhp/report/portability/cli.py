@@ -352,9 +352,9 @@ def _load_claims(plan: _Plan) -> _Claims:
     missing = [s for s in sections if s not in nat_by]
     if missing:
         raise _Abort(f"the native run has no report section {', '.join(missing)}")
-    nat_claims = [c for s in sections for c in nat_by[s]]
     emu_claims = [c for s in sections for c in emu_by[s]]
-    reported = {c.id: c for c in load_claims(plan.native_dir / "results/paper/claims.json")[0]}
+    reported = {c.id: c for c in nat_claims}  # the native report's, loaded above
+    nat_claims = [c for s in sections for c in nat_by[s]]
     changed = [c.id for c in nat_claims if c.id in reported and not _same(c, reported[c.id])]
     if changed:
         raise _Abort(
