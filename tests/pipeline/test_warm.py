@@ -93,3 +93,40 @@ def test_cli_refuses_zero_cores(capsys):
     with pytest.raises(SystemExit):
         warm.main(["--cores", "0"])
     assert "--cores must be >= 1, got 0" in capsys.readouterr().err
+
+
+def test_tasks_for_keeps_the_named_modules_entries_in_order():
+    assert warm.tasks_for(None) == warm.TASKS
+    assert warm.tasks_for(set()) == ()
+    # a module of the second task alone: the first (the planner kernel) is dropped
+    assert warm.tasks_for({"rsmhp.core.designs"}) == (("rsmhp.core.designs",),)
+    picked = warm.tasks_for({"rsmhp.models.lqg.regret", "rsmhp.models.uav.target"})
+    assert picked == (("rsmhp.models.uav.target", "rsmhp.models.lqg.regret"),)
+    # a module whose kernels are compiled with another's (LINKED) brings that module's
+    # entries, the module:function ones included
+    linked, owner = next(iter(warm.LINKED.items()))
+    entries = {e for task in warm.tasks_for({linked}) for e in task}
+    assert entries == {e for task in warm.TASKS for e in task if e.partition(":")[0] == owner}
+    # modules without kernels select nothing
+    assert warm.tasks_for({"rsmhp.pipeline.io", "rsmhp"}) == ()
+
+
+def test_the_scripts_of_some_rules_select_only_their_kernels():
+    scripts = SRC.parent / "workflow" / "scripts"
+    lqg = warm.modules_of_scripts([scripts / "lqg_convergence.py"])
+    assert "rsmhp.models.lqg.oven" in lqg and "rsmhp.models.uav.fused" not in lqg
+    uav = warm.tasks_for(warm.modules_of_scripts([scripts / "uav_simulate.py"]))
+    assert ("rsmhp.models.uav.fused",) in uav
+
+
+def test_cli_refuses_a_missing_script(capsys, tmp_path):
+    with pytest.raises(SystemExit):
+        warm.main(["--scripts", str(tmp_path / "nope.py")])
+    assert "no such rule script" in capsys.readouterr().err
+
+
+def test_cli_with_scripts_that_need_no_kernel_compiles_nothing(capsys, tmp_path):
+    script = tmp_path / "plain.py"
+    script.write_text("import rsmhp.pipeline.io\n")
+    warm.main(["--cores", "1", "--scripts", str(script)])
+    assert "no kernel to compile" in capsys.readouterr().out

@@ -27,7 +27,12 @@ cache loads in well under a second, so running this again costs little. The cach
 target: numba keys it on the LLVM CPU name and features, so ``NUMBA_CPU_NAME`` (the AVX2 and
 portability emulations) compiles again, once.
 
-    python -m rsmhp.pipeline.warm [--cores N]
+A run of some targets needs only the kernels its jobs can call: ``--scripts`` names their
+rule scripts, and only the entries of :data:`TASKS` whose module one of them can import
+(statically, as :func:`rsmhp.pipeline.code_digest.describe` follows imports) are compiled
+(:func:`tasks_for`). The portability drill of some studies does this.
+
+    python -m rsmhp.pipeline.warm [--cores N] [--scripts workflow/scripts/<rule>.py ...]
 """
 
 from __future__ import annotations
@@ -37,9 +42,11 @@ import importlib
 import multiprocessing
 import os
 import time
+from collections.abc import Iterable
 from concurrent.futures import ProcessPoolExecutor
+from pathlib import Path
 
-__all__ = ["LINKED", "TASKS", "main", "warm"]
+__all__ = ["LINKED", "TASKS", "main", "modules_of_scripts", "tasks_for", "warm"]
 
 #: tasks of one process each: the modules whose ``warm_up()`` it calls, in order
 #: (``module:function`` calls that function of the module instead)
@@ -64,6 +71,35 @@ TASKS: tuple[tuple[str, ...], ...] = (
 LINKED: dict[str, str] = {"rsmhp.core.boxqn": "rsmhp.models.uav.fused"}
 
 
+def tasks_for(modules: Iterable[str] | None) -> tuple[tuple[str, ...], ...]:
+    """The entries of :data:`TASKS` that compile kernels of ``modules`` (dotted module names,
+    e.g. :func:`modules_of_scripts`): an entry counts when its module is named, or when a
+    named module's kernels are compiled with it (:data:`LINKED`). Each task keeps its order;
+    tasks left empty are dropped. ``None``: every task."""
+    if modules is None:
+        return TASKS
+    wanted = set(modules)
+    wanted |= {owner for linked, owner in LINKED.items() if linked in wanted}
+    kept = (tuple(e for e in task if e.partition(":")[0] in wanted) for task in TASKS)
+    return tuple(task for task in kept if task)
+
+
+def modules_of_scripts(
+    scripts: Iterable[str | os.PathLike], src: str | os.PathLike | None = None
+) -> set[str]:
+    """Every ``rsmhp`` module (under ``src``, by default the imported package's directory)
+    that one of ``scripts`` can import, followed statically
+    (:func:`rsmhp.pipeline.code_digest.describe`)."""
+    from rsmhp.pipeline.code_digest import describe
+
+    out: set[str] = set()
+    for script in scripts:
+        if not Path(script).is_file():
+            raise FileNotFoundError(f"warm: --scripts: no such rule script {script}")
+        out.update(describe(script, src).modules)
+    return out
+
+
 def _run(modules: tuple[str, ...]) -> list[tuple[str, float]]:
     """Call each module's ``warm_up()`` (or the function a ``module:function`` entry names) in
     this process; (entry, seconds) per entry."""
@@ -74,18 +110,21 @@ def _run(modules: tuple[str, ...]) -> list[tuple[str, float]]:
     return out
 
 
-def warm(cores: int) -> tuple[float, list[tuple[str, float]]]:
-    """Compile (or load) every kernel with ``cores`` processes (1: in this process); returns
-    (wall seconds, (module, seconds) per module)."""
+def warm(
+    cores: int, tasks: tuple[tuple[str, ...], ...] = TASKS
+) -> tuple[float, list[tuple[str, float]]]:
+    """Compile (or load) the kernels of ``tasks`` (default every one; see :func:`tasks_for`)
+    with ``cores`` processes (1: in this process); returns (wall seconds, (module, seconds)
+    per module)."""
     if not isinstance(cores, int) or isinstance(cores, bool) or cores < 1:
         raise ValueError(f"cores must be an integer >= 1, got {cores!r}")
     t0 = time.perf_counter()
-    if cores == 1:
-        per = [row for task in TASKS for row in _run(task)]
+    if cores == 1 or len(tasks) <= 1:
+        per = [row for task in tasks for row in _run(task)]
     else:
         ctx = multiprocessing.get_context("spawn")
-        with ProcessPoolExecutor(max_workers=min(cores, len(TASKS)), mp_context=ctx) as pool:
-            per = [row for rows in pool.map(_run, TASKS) for row in rows]
+        with ProcessPoolExecutor(max_workers=min(cores, len(tasks)), mp_context=ctx) as pool:
+            per = [row for rows in pool.map(_run, tasks) for row in rows]
     return time.perf_counter() - t0, per
 
 
@@ -97,10 +136,25 @@ def main(argv: list[str] | None = None) -> None:
     parser.add_argument(
         "--cores", type=int, default=os.cpu_count() or 1, help="processes (default: all cores)"
     )
+    parser.add_argument(
+        "--scripts",
+        nargs="+",
+        default=None,
+        metavar="SCRIPT",
+        help="only the kernels that these rule scripts can import (default: every kernel)",
+    )
     args = parser.parse_args(argv)
     if args.cores < 1:
         parser.error(f"--cores must be >= 1, got {args.cores}")
-    wall, per = warm(args.cores)
+    try:
+        modules = None if args.scripts is None else modules_of_scripts(args.scripts)
+    except FileNotFoundError as exc:
+        parser.error(str(exc))
+    tasks = tasks_for(modules)
+    wall, per = warm(args.cores, tasks)
+    if not per:
+        print("no kernel to compile: the scripts import no module with numba kernels")
+        return
     detail = ", ".join(f"{name.rsplit('.', 1)[-1]} {sec:.1f} s" for name, sec in per)
     print(f"compiled kernels ready in {wall:.1f} s wall with {args.cores} cores ({detail})")
 

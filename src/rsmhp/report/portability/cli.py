@@ -10,6 +10,7 @@ import argparse
 import json
 import math
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -257,6 +258,42 @@ def _snakemake(
     return code
 
 
+_RULE = re.compile(r"^rule (\w+):", re.M)
+_SCRIPT = re.compile(r"^\s+script:\s*\n\s+\"\.\./scripts/([\w.]+\.py)\"", re.M)
+_LABEL = re.compile(r'label = "(\w+)"')
+
+
+def rule_scripts(snakefile: Path) -> dict[str, Path]:
+    """Rule name -> its ``script:`` (a path under ``workflow/scripts``) for every rule of the
+    workflow ``snakefile`` that has one, read from ``workflow/rules/*.smk`` (a rule's
+    ``script:`` comes before the next ``rule``)."""
+    rules_dir = snakefile.parent / "workflow" / "rules"
+    out: dict[str, Path] = {}
+    for smk in sorted(rules_dir.glob("*.smk")):
+        text = smk.read_text(encoding="utf-8")
+        starts = [(m.start(), m.group(1)) for m in _RULE.finditer(text)]
+        ends = [start for start, _ in starts[1:]] + [len(text)]
+        for (start, name), end in zip(starts, ends[: len(starts)], strict=True):
+            found = _SCRIPT.search(text, start, end)
+            if found:
+                out[name] = snakefile.parent / "workflow" / "scripts" / found.group(1)
+    return out
+
+
+def _target_scripts(plan: _Plan, envs: _Environments) -> list[Path]:
+    """The rule scripts of every job the drill's targets need, from the workflow copy's rule
+    graph for those targets (``snakemake --rulegraph``: parsed, no job run)."""
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(envs.snakefile), "-d", str(plan.workdir)]
+    cmd += [*(["--configfile", *plan.configfiles] if plan.configfiles else [])]
+    cmd += ["--rulegraph", "dot", *plan.args.target]
+    res = subprocess.run(cmd, env=envs.native, capture_output=True, text=True, check=False)
+    rules = set(_LABEL.findall(res.stdout))
+    if res.returncode or not rules:
+        raise _Abort(f"the rule graph of {plan.args.target} failed: {res.stderr[-2000:]}")
+    scripts = rule_scripts(envs.snakefile)
+    return sorted(scripts[r] for r in rules if r in scripts)
+
+
 def _run_workflows(plan: _Plan, envs: _Environments) -> None:
     """Complete the native run with the checkout's workflow (unless ``--no-native-run``), then
     make the emulated run with the copy, logged to ``<drill>/snakemake.log``."""
@@ -284,6 +321,9 @@ def _run_workflows(plan: _Plan, envs: _Environments) -> None:
     # From the copy's src/, first on the path as in its jobs: numba's cache is keyed on the
     # source file, so kernels compiled from the checkout's src/ would not be the jobs'
     warm = [sys.executable, "-m", "rsmhp.pipeline.warm", "--cores", str(args.cores)]
+    if not {"report", "all"} & set(args.target):
+        # some studies: only the kernels their jobs' scripts can import
+        warm += ["--scripts", *map(str, _target_scripts(plan, envs))]
     src = str(envs.snakefile.parent / "src")
     path = os.pathsep.join(filter(None, [src, envs.emulated.get("PYTHONPATH")]))
     if subprocess.run(warm, env={**envs.emulated, "PYTHONPATH": path}, check=False).returncode:
