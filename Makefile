@@ -20,6 +20,7 @@ export NPY_DISABLE_CPU_FEATURES := X86_V4 AVX512_ICL AVX512_SPR
 else ifneq ($(EMULATE),)
 $(error EMULATE=$(EMULATE): the only emulation is avx2 (or leave EMULATE unset))
 endif
+PACKAGES := $(VENV)/.rsmhp-packages
 STAMP := $(VENV)/.rsmhp-installed
 # install into the venv with uv when it is there, else with pip: $(call INSTALL,args)
 INSTALL = if test -x $(BIN)/uv; then $(BIN)/uv pip install --quiet --python $(BIN)/python $(1); \
@@ -47,13 +48,18 @@ help:
 	@echo "Rules and targets (snakemake --list-rules):"
 	@test -x $(BIN)/snakemake && $(BIN)/snakemake --list-rules 2>/dev/null | sed 's/^/  /' || echo "  (run make setup first)"
 
-$(STAMP): pyproject.toml
+# two steps: the packages (PACKAGES, what lint needs), then the compiled kernels (STAMP, what
+# everything else needs); make test lints while the kernels compile
+$(PACKAGES): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "rsmhp needs Python >= 3.11, found " + sys.version.split()[0])'
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	@# uv (from PyPI, into the venv) resolves and installs the same releases as pip, in about
 	@# 20 s against pip's 70 (docs/performance.md, "Set-up"); pip does it if uv cannot be had
 	$(BIN)/python -m pip install --quiet uv || true
 	$(call INSTALL,-e '.[dev]')
+	@touch $(PACKAGES)
+
+$(STAMP): $(PACKAGES)
 	@# compile every numba kernel once per machine, in parallel (on-disk cache; every job loads it)
 	$(BIN)/python -m rsmhp.pipeline.warm --cores $(CORES)
 	@touch $(STAMP)
@@ -111,7 +117,7 @@ verify: $(STAMP)
 portability: $(STAMP)
 	$(BIN)/python -m rsmhp.report.portability --cores $(CORES) $(ARGS)
 
-lint: $(STAMP)
+lint: $(PACKAGES)
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
 	$(BIN)/snakefmt --check .
@@ -122,7 +128,7 @@ lint: $(STAMP)
 PLUGIN := examples/rsmhp-plugin-example
 PLUGIN_STAMP := $(VENV)/.rsmhp-plugin-example-installed
 
-$(PLUGIN_STAMP): $(STAMP) $(PLUGIN)/pyproject.toml
+$(PLUGIN_STAMP): $(PACKAGES) $(PLUGIN)/pyproject.toml
 	$(call INSTALL,-e $(PLUGIN))
 	@touch $(PLUGIN_STAMP)
 
@@ -131,12 +137,15 @@ $(PLUGIN_STAMP): $(STAMP) $(PLUGIN)/pyproject.toml
 # tiny runs are made once and shared by the workers (tests/conftest.py). Serially:
 # $(BIN)/pytest tests
 XDIST := -n $(CORES) --dist loadfile --no-loadscope-reorder
-# lint runs beside the tests (one process, about 20 s), its output printed after theirs; make
-# test fails if either fails (make then exits 2 whatever pytest's status, 5 when no test ran
-# included: .ci/run fails on any non-zero status)
+# lint (one process, about 20 s) runs beside the kernels' compile (whose second process ends
+# first) and the tests, its output printed after theirs; make test fails if either fails (make
+# then exits 2 whatever pytest's status, 5 when no test ran included: .ci/run fails on any
+# non-zero status)
 test: $(PLUGIN_STAMP)
 	@log=$$(mktemp); $(MAKE) --no-print-directory lint > $$log 2>&1 & lint=$$!; \
+	if $(MAKE) --no-print-directory $(STAMP); then \
 	$(BIN)/python -m pytest $(XDIST) --durations=25 tests $(PLUGIN)/tests; rc=$$?; \
+	else rc=1; echo "make test: set-up failed (above)" >&2; fi; \
 	wait $$lint; lint_rc=$$?; echo "--- make lint (beside the tests)"; cat $$log; rm -f $$log; \
 	if [ $$lint_rc -ne 0 ]; then echo "make test: lint failed (above)" >&2; exit 1; fi; \
 	exit $$rc
@@ -146,7 +155,7 @@ test: $(PLUGIN_STAMP)
 # CPU (compile); no lint. make test runs them all. On CORES pytest-xdist workers that take work
 # from each other (no test of this tier shares anything across processes).
 FAST := not workflow and not slurm and not compile
-test-fast: $(PLUGIN_STAMP)
+test-fast: $(STAMP) $(PLUGIN_STAMP)
 	$(BIN)/python -m pytest -n $(CORES) --dist worksteal --durations=10 -m "$(FAST)" tests $(PLUGIN)/tests
 
 clean:
