@@ -184,16 +184,22 @@ def test_a_drill_of_some_sections_compares_their_claims(tmp_path):
         native_dir=nat,
         workdir=emu,
         args=SimpleNamespace(target=["results/report/one.json"]),
+        started=None,
     )
     got = cli._load_claims(plan)
     assert got.sections == ["one"] and got.config_hash == "abc"
     assert [x.id for x in got.reference] == [x.id for x in got.native] == ["A", "B"]
     assert got.emulated[1].key.value == 2.5
     assert got.n_statistical == 1  # the whole reference's, as make verify counts them
-    # the whole report, when the emulated run made it
+    # a section the targets neither name nor made (an earlier drill's) is left out
+    _write_claims(emu / "results/report/two.json", [c], None)
+    assert cli._load_claims(plan).sections == ["one"]
+    # the whole report, when the targets make it
     _write_claims(emu / "results/paper/claims.json", [a, b, c])
+    plan.args.target = ["report"]
     full = cli._load_claims(plan)
     assert full.sections is None and [x.id for x in full.emulated] == ["A", "B", "C"]
+    plan.args.target = ["results/report/one.json"]
     (emu / "results/paper/claims.json").unlink()
     # refusals
     _write_claims(nat / "results/paper/claims.json", [a, _claim("B", 2.0, "inconclusive", True), c])
@@ -485,3 +491,28 @@ def test_rule_scripts_finds_every_rule_script_and_only_those(tmp_path):
         'rule job:\n    output:\n        "x"\n    script:\n        "../scripts/job.py"\n'
     )
     assert rule_scripts(tmp_path / "Snakefile") == {"job": tmp_path / "workflow/scripts/job.py"}
+
+
+def test_a_reused_workdir_compares_only_the_sections_this_drill_made(tmp_path):
+    import time as _time
+
+    from rsmhp.report.portability.cli import _whole_report, target_sections
+
+    report = tmp_path / "results" / "report"
+    report.mkdir(parents=True)
+    old = report / "uav.json"  # left by an earlier drill in the same working directory
+    old.write_text("{}")
+    os.utime(old, (1_000_000_000, 1_000_000_000))
+    since = _time.time()
+    (report / "lqg.json").write_text("{}")  # made by this drill's rule target
+    # named targets count even when already up to date; an earlier drill's section does not
+    assert target_sections(["lqg"], tmp_path, since) == {"lqg"}
+    assert target_sections(["results/report/horizon.json"], tmp_path, since) == {
+        "horizon",
+        "lqg",
+    }
+    assert target_sections(["./results/report/uav.json"], tmp_path, since) == {"uav", "lqg"}
+    assert target_sections(["lqg"], tmp_path, None) == set()
+    assert _whole_report(["report"]) and _whole_report(["all", "x"])
+    assert _whole_report(["results/paper/claims.json"])
+    assert not _whole_report(["results/report/lqg.json", "uav_collect"])

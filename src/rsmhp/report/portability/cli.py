@@ -16,6 +16,7 @@ import subprocess
 import sys
 import tempfile
 import textwrap
+import time
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -67,6 +68,8 @@ class _Plan:
     reference: Path
     temporary: bool
     workdir: Path
+    #: when the emulated run started (time.time()): report sections written since are its own
+    started: float | None = None
 
     @property
     def drill_dir(self) -> Path:
@@ -301,7 +304,7 @@ def _run_workflows(plan: _Plan, envs: _Environments) -> None:
     if not args.no_native_run:
         print("portability: completing the native run", flush=True)
         # the native run is make verify's: its report too, whatever the emulated run's targets
-        full = {"report", "all"} & set(args.target)
+        full = _whole_report(args.target)
         code = _snakemake(
             plan.native_dir,
             plan.checkout / "Snakefile",
@@ -315,13 +318,14 @@ def _run_workflows(plan: _Plan, envs: _Environments) -> None:
         if code:
             raise _Abort("the native run failed")
     print(f"portability: emulated run in {plan.workdir}", flush=True)
+    plan.started = time.time()
     log = plan.drill_dir / "snakemake.log"
     # compile the emulated CPU's kernels first, on every core (rsmhp.pipeline.warm): the
     # workflow's jobs would each compile what they call, two at once compiling the same kernel.
     # From the copy's src/, first on the path as in its jobs: numba's cache is keyed on the
     # source file, so kernels compiled from the checkout's src/ would not be the jobs'
     warm = [sys.executable, "-m", "rsmhp.pipeline.warm", "--cores", str(args.cores)]
-    if not {"report", "all"} & set(args.target):
+    if not _whole_report(args.target):
         # some studies: only the kernels their jobs' scripts can import
         warm += ["--scripts", *map(str, _target_scripts(plan, envs))]
     src = str(envs.snakefile.parent / "src")
@@ -368,12 +372,14 @@ def _load_claims(plan: _Plan) -> _Claims:
     try:
         ref_claims, ref_hash = load_claims(plan.reference)
         nat_claims, nat_hash = load_claims(plan.native_dir / "results/paper/claims.json")
-        if (plan.workdir / "results/paper/claims.json").is_file():
+        if _whole_report(plan.args.target):
             emu_claims, emu_hash = load_claims(plan.workdir / "results/paper/claims.json")
             sections = None
         else:
             emu_by = section_claims(plan.workdir / "results/report")
             nat_by = section_claims(plan.native_dir / "results/report")
+            made = target_sections(plan.args.target, plan.workdir, plan.started)
+            emu_by = {s: c for s, c in emu_by.items() if s in made}
             sections, emu_hash = sorted(emu_by), nat_hash
     except ValueError as exc:
         raise _Abort(str(exc)) from exc
@@ -405,6 +411,31 @@ def _load_claims(plan: _Plan) -> _Claims:
     scoped = [c for c in ref_claims if c.id in ids]
     n_stat = sum(c.key.reproducible == "statistical" for c in ref_claims)
     return _Claims(scoped, nat_claims, emu_claims, ref_hash, sections, n_stat)
+
+
+def _whole_report(targets: Sequence[str]) -> bool:
+    """Whether the targets make the whole report (``report``, ``all`` or a file of
+    ``results/paper/``)."""
+    return bool({"report", "all"} & set(targets)) or any(
+        t.removeprefix("./").startswith("results/paper/") for t in targets
+    )
+
+
+def target_sections(
+    targets: Sequence[str], workdir: str | os.PathLike, since: float | None
+) -> set[str]:
+    """The report sections a drill of ``targets`` compares: those the targets name
+    (``results/report/<study>.json``) and those the emulated run in ``workdir`` wrote at or
+    after ``since`` (other targets, e.g. a study's rule, make theirs). A section an earlier
+    drill left in a reused working directory is neither, and is not compared."""
+    named = {Path(t).stem for t in targets if re.fullmatch(r"(\./)?results/report/\w+\.json", t)}
+    report = Path(workdir) / "results" / "report"
+    fresh = {
+        p.stem
+        for p in report.glob("*.json")
+        if since is not None and p.stat().st_mtime >= since - 1.0  # coarse file-system clocks
+    }
+    return named | fresh
 
 
 def _same(a: Any, b: Any) -> bool:
