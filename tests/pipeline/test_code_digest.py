@@ -277,3 +277,32 @@ def test_a_template_counts_for_the_modules_that_render_it(tree):
     _edit(src / "rsmhp/st/section.md", "The {{ value }}", "A {{ value }}")
     assert describe(sim, src).digest == before_sim.digest
     assert describe(summary, src).digest != before_summary.digest
+
+
+def test_module_lookups_see_a_module_added_or_removed_after_them(tree):
+    """_locate remembers its answers while the directories they depend on keep their
+    modification times: adding or removing a module (or turning it into a package) is seen."""
+    import os
+
+    script, src = tree
+    script.write_text("import rsmhp.sub.late\n")
+    assert "rsmhp.sub.late" not in describe(script, src).modules  # not there yet
+
+    def bump(path: Path) -> None:  # file systems with coarse clocks: make the change visible
+        st = os.stat(path)
+        os.utime(path, ns=(st.st_atime_ns, st.st_mtime_ns + 10_000_000))
+
+    (src / "rsmhp/sub/late.py").write_text("L = 1\n")
+    bump(src / "rsmhp/sub")
+    assert "rsmhp.sub.late" in describe(script, src).modules
+    (src / "rsmhp/sub/late.py").unlink()
+    bump(src / "rsmhp/sub")
+    (src / "rsmhp/sub/late").mkdir()
+    (src / "rsmhp/sub/late/__init__.py").write_text("P = 2\n")
+    bump(src / "rsmhp/sub")
+    found = cd._locate("rsmhp.sub.late", src)
+    assert found == (src / "rsmhp/sub/late/__init__.py", True)
+    shutil.rmtree(src / "rsmhp/sub/late")
+    bump(src / "rsmhp/sub")
+    assert cd._locate("rsmhp.sub.late", src) is None
+    assert "rsmhp.sub.late" not in describe(script, src).modules
