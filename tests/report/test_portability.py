@@ -454,6 +454,8 @@ def test_drill_on_the_tiny_config(run_j2, tmp_path):
         if p.suffix in (".csv", ".parquet")
     }
     assert set(tables) == emulated_tables
+    # ... and those are the two studies' alone: the run made what its targets need
+    assert {name.split("/")[0] for name in tables} == {"lqg", "estimators"}
     assert {"lqg/convergence.csv", "estimators/ablation.csv"} <= set(tables)
     assert not [n for n, t in tables.items() if t["status"].startswith("missing")]
     for name, t in tables.items():
