@@ -25,7 +25,7 @@ STAMP := $(VENV)/.rsmhp-installed
 # install into the venv with uv when it is there, else with pip: $(call INSTALL,args). uv
 # compiles the bytecode as pip does (--compile-bytecode): without it, where Python writes no
 # .pyc (PYTHONDONTWRITEBYTECODE, a read-only venv) every process, each job and each parse,
-# compiles snakemake, pandas and scipy again (the test suite took 1.6 times as long)
+# compiles snakemake, pandas and scipy again (docs/performance.md, "Set-up")
 INSTALL = if test -x $(BIN)/uv; then $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python $(1); \
 	else $(BIN)/python -m pip install --quiet $(1); fi
 
