@@ -26,8 +26,8 @@ STAMP := $(VENV)/.rsmhp-installed
 # compiles the bytecode as pip does (--compile-bytecode): without it, where Python writes no
 # .pyc (PYTHONDONTWRITEBYTECODE, a read-only venv) every process, each job and each parse,
 # compiles snakemake, pandas and scipy again (docs/performance.md, "Set-up")
-INSTALL = if test -x $(BIN)/uv; then $(BIN)/uv pip install --quiet --compile-bytecode --python $(BIN)/python $(1); \
-	else $(BIN)/python -m pip install --quiet $(1); fi
+INSTALL = if test -x $(BIN)/uv && $(BIN)/uv pip install --quiet --compile-bytecode \
+	--python $(BIN)/python $(1); then :; else $(BIN)/python -m pip install --quiet $(1); fi
 
 .PHONY: help replicate tune publish verify portability compare test test-fast lint setup clean
 
@@ -57,7 +57,7 @@ $(PACKAGES): pyproject.toml
 	@$(PYTHON) -c 'import sys; sys.exit(0 if sys.version_info >= (3, 11) else "rsmhp needs Python >= 3.11, found " + sys.version.split()[0])'
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	@# uv (from PyPI, into the venv) resolves and installs the same releases as pip, in about
-	@# 20 s against pip's 70 (docs/performance.md, "Set-up"); pip does it if uv cannot be had
+	@# 22 s against pip's 78 (docs/performance.md, "Set-up"); pip does it if uv fails
 	$(BIN)/python -m pip install --quiet uv || true
 	$(call INSTALL,-e '.[dev]')
 	@touch $(PACKAGES)
@@ -145,7 +145,7 @@ XDIST := -n $(CORES) --dist loadfile --no-loadscope-reorder
 # then exits 2 whatever pytest's status, 5 when no test ran included: .ci/run fails on any
 # non-zero status)
 test: $(PLUGIN_STAMP)
-	@log=$$(mktemp); $(MAKE) --no-print-directory lint > $$log 2>&1 & lint=$$!; \
+	@log=$$(mktemp); $(MAKE) --no-print-directory -o $(PACKAGES) lint > $$log 2>&1 & lint=$$!; \
 	if $(MAKE) --no-print-directory $(STAMP); then \
 	$(BIN)/python -m pytest $(XDIST) --durations=25 tests $(PLUGIN)/tests; rc=$$?; \
 	else rc=1; echo "make test: set-up failed (above)" >&2; fi; \

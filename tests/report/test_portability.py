@@ -516,5 +516,6 @@ def test_a_reused_workdir_compares_only_the_sections_this_drill_made(tmp_path):
     assert target_sections(["./results/report/uav.json"], tmp_path, since) == {"uav", "lqg"}
     assert target_sections(["lqg"], tmp_path, None) == set()
     assert _whole_report(["report"]) and _whole_report(["all", "x"])
-    assert _whole_report(["results/paper/claims.json"])
+    assert _whole_report(["results/paper/claims.json"]) and _whole_report(["verify"])
+    assert _whole_report(["./results/verify.md"]) and _whole_report(["results/provenance.json"])
     assert not _whole_report(["results/report/lqg.json", "uav_collect"])

@@ -325,12 +325,14 @@ def _run_workflows(plan: _Plan, envs: _Environments) -> None:
     # From the copy's src/, first on the path as in its jobs: numba's cache is keyed on the
     # source file, so kernels compiled from the checkout's src/ would not be the jobs'
     warm = [sys.executable, "-m", "rsmhp.pipeline.warm", "--cores", str(args.cores)]
-    if not _whole_report(args.target):
-        # some studies: only the kernels their jobs' scripts can import
-        warm += ["--scripts", *map(str, _target_scripts(plan, envs))]
+    scripts = None if _whole_report(args.target) else _target_scripts(plan, envs)
+    if scripts is not None:  # some studies: only the kernels their jobs' scripts can import
+        warm += ["--scripts", *map(str, scripts)]
     src = str(envs.snakefile.parent / "src")
     path = os.pathsep.join(filter(None, [src, envs.emulated.get("PYTHONPATH")]))
-    if subprocess.run(warm, env={**envs.emulated, "PYTHONPATH": path}, check=False).returncode:
+    if scripts == []:
+        print("portability: the targets' rules run no script: no kernel to compile", flush=True)
+    elif subprocess.run(warm, env={**envs.emulated, "PYTHONPATH": path}, check=False).returncode:
         raise _Abort("compiling the kernels for the emulated CPU failed")
     if _snakemake(
         plan.workdir,
@@ -414,10 +416,13 @@ def _load_claims(plan: _Plan) -> _Claims:
 
 
 def _whole_report(targets: Sequence[str]) -> bool:
-    """Whether the targets make the whole report (``report``, ``all`` or a file of
-    ``results/paper/``)."""
-    return bool({"report", "all"} & set(targets)) or any(
-        t.removeprefix("./").startswith("results/paper/") for t in targets
+    """Whether the targets make the whole report: ``report``, ``all``, ``verify`` (it
+    compares the report's claims), or a file of ``results/paper/``, ``results/verify.md`` or
+    ``results/provenance.json`` (the report rule's)."""
+    files = {"results/verify.md", "results/provenance.json"}
+    return bool({"report", "all", "verify"} & set(targets)) or any(
+        t.removeprefix("./").startswith("results/paper/") or t.removeprefix("./") in files
+        for t in targets
     )
 
 
@@ -427,7 +432,9 @@ def target_sections(
     """The report sections a drill of ``targets`` compares: those the targets name
     (``results/report/<study>.json``) and those the emulated run in ``workdir`` wrote at or
     after ``since`` (other targets, e.g. a study's rule, make theirs). A section an earlier
-    drill left in a reused working directory is neither, and is not compared."""
+    drill left in a reused working directory is neither, and is not compared; so neither is
+    one a rule target made in an earlier drill there and left up to date (name the section
+    file as a target to compare it)."""
     named = {Path(t).stem for t in targets if re.fullmatch(r"(\./)?results/report/\w+\.json", t)}
     report = Path(workdir) / "results" / "report"
     fresh = {
