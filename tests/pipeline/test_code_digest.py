@@ -161,12 +161,7 @@ def test_a_missing_script_is_named(tmp_path):
 
 
 def _rule_blocks() -> dict[str, str]:
-    blocks = {}
-    for smk in sorted((ROOT / "workflow/rules").glob("*.smk")):
-        for block in re.split(r"\n(?=rule )", smk.read_text()):
-            if m := re.match(r"rule (\w+):", block):
-                blocks[m.group(1)] = block
-    return blocks
+    return cd.rule_blocks(ROOT / "workflow")
 
 
 def test_every_rule_with_a_script_carries_the_digest_of_that_script():

@@ -478,9 +478,9 @@ def _section(run: Path, name: str) -> dict:
 
 
 def test_rule_scripts_finds_every_rule_script_and_only_those(tmp_path):
-    from rsmhp.report.portability.cli import rule_scripts
+    from rsmhp.pipeline.code_digest import rule_scripts
 
-    found = rule_scripts(ROOT / "Snakefile")
+    found = rule_scripts(ROOT / "workflow")
     text = "".join(p.read_text() for p in (ROOT / "workflow/rules").glob("*.smk"))
     assert len(found) == text.count("\n    script:")
     assert all(p.is_file() for p in found.values())
@@ -492,7 +492,7 @@ def test_rule_scripts_finds_every_rule_script_and_only_those(tmp_path):
         'rule target:\n    input:\n        "x"\n\n\n'
         'rule job:\n    output:\n        "x"\n    script:\n        "../scripts/job.py"\n'
     )
-    assert rule_scripts(tmp_path / "Snakefile") == {"job": tmp_path / "workflow/scripts/job.py"}
+    assert rule_scripts(tmp_path / "workflow") == {"job": tmp_path / "workflow/scripts/job.py"}
 
 
 def test_a_reused_workdir_compares_only_the_sections_this_drill_made(tmp_path):

@@ -54,6 +54,7 @@ import contextlib
 import hashlib
 import json
 import os
+import re
 import sys
 import tempfile
 from collections.abc import Iterable, Mapping
@@ -69,6 +70,8 @@ __all__ = [
     "describe",
     "method_only",
     "module_digest",
+    "rule_blocks",
+    "rule_scripts",
     "split_stamp_rule",
     "workflow_src",
 ]
@@ -306,6 +309,33 @@ def _package_modules(package: str, src: Path) -> list[str]:
 def _default_src() -> Path:
     """The directory holding this (imported) package."""
     return Path(__file__).resolve().parents[2]
+
+
+_RULE_START = re.compile(r"\n(?=rule )")
+_RULE_NAME = re.compile(r"rule (\w+):")
+_SCRIPT = re.compile(r'^\s+script:\s*\n\s+"\.\./scripts/([\w.]+\.py)"', re.M)
+
+
+def rule_blocks(workflow_dir: str | os.PathLike) -> dict[str, str]:
+    """Rule name -> its text (up to the next rule) for every rule of
+    ``<workflow_dir>/rules/*.smk``."""
+    blocks = {}
+    for smk in sorted(Path(workflow_dir, "rules").glob("*.smk")):
+        for block in _RULE_START.split(smk.read_text(encoding="utf-8")):
+            if m := _RULE_NAME.match(block):
+                blocks[m.group(1)] = block
+    return blocks
+
+
+def rule_scripts(workflow_dir: str | os.PathLike) -> dict[str, Path]:
+    """Rule name -> its ``script:`` (``<workflow_dir>/scripts/<file>.py``) for every rule of
+    :func:`rule_blocks` that has one."""
+    scripts = Path(workflow_dir, "scripts")
+    return {
+        name: scripts / m.group(1)
+        for name, block in rule_blocks(workflow_dir).items()
+        if (m := _SCRIPT.search(block))
+    }
 
 
 def workflow_src(scripts: str | os.PathLike) -> Path:

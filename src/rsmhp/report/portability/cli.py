@@ -24,6 +24,7 @@ from typing import Any
 
 import numpy as np
 
+from rsmhp.pipeline.code_digest import rule_scripts
 from rsmhp.report.portability.compare import compare_claims, compare_results, section_claims
 from rsmhp.report.portability.emulation import (
     COMPONENTS,
@@ -223,6 +224,12 @@ def _environments(plan: _Plan) -> _Environments:
     return _Environments(native_env, native_probe, env, emulated_probe, snakefile, shown_env)
 
 
+def _snakemake_cmd(workdir: Path, snakefile: Path, configfiles: Sequence[str]) -> list[str]:
+    """``python -m snakemake`` of ``snakefile`` in ``workdir`` with ``configfiles``."""
+    cmd = [sys.executable, "-m", "snakemake", "-s", str(snakefile), "-d", str(workdir)]
+    return cmd + (["--configfile", *configfiles] if configfiles else [])
+
+
 def _snakemake(
     workdir: Path,
     snakefile: Path,
@@ -235,9 +242,8 @@ def _snakemake(
 ) -> int:
     """Run ``snakemake`` in ``workdir`` (echoed unless ``quiet``, appended to ``log``); its
     exit status (a failure shows the last 41 lines of its output even when ``quiet``)."""
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(snakefile), "-d", str(workdir)]
     # targets after an option: after --configfile's files they would be read as files
-    cmd += [*(["--configfile", *configfiles] if configfiles else []), f"-j{cores}", *targets]
+    cmd = [*_snakemake_cmd(workdir, snakefile, configfiles), f"-j{cores}", *targets]
     print("$ " + " ".join(cmd), flush=True)
     fh = open(log, "a", encoding="utf-8") if log else None
     try:
@@ -261,39 +267,19 @@ def _snakemake(
     return code
 
 
-_RULE = re.compile(r"^rule (\w+):", re.M)
-_SCRIPT = re.compile(r"^\s+script:\s*\n\s+\"\.\./scripts/([\w.]+\.py)\"", re.M)
 _LABEL = re.compile(r'label = "(\w+)"')
-
-
-def rule_scripts(snakefile: Path) -> dict[str, Path]:
-    """Rule name -> its ``script:`` (a path under ``workflow/scripts``) for every rule of the
-    workflow ``snakefile`` that has one, read from ``workflow/rules/*.smk`` (a rule's
-    ``script:`` comes before the next ``rule``)."""
-    rules_dir = snakefile.parent / "workflow" / "rules"
-    out: dict[str, Path] = {}
-    for smk in sorted(rules_dir.glob("*.smk")):
-        text = smk.read_text(encoding="utf-8")
-        starts = [(m.start(), m.group(1)) for m in _RULE.finditer(text)]
-        ends = [start for start, _ in starts[1:]] + [len(text)]
-        for (start, name), end in zip(starts, ends[: len(starts)], strict=True):
-            found = _SCRIPT.search(text, start, end)
-            if found:
-                out[name] = snakefile.parent / "workflow" / "scripts" / found.group(1)
-    return out
 
 
 def _target_scripts(plan: _Plan, envs: _Environments) -> list[Path]:
     """The rule scripts of every job the drill's targets need, from the workflow copy's rule
     graph for those targets (``snakemake --rulegraph``: parsed, no job run)."""
-    cmd = [sys.executable, "-m", "snakemake", "-s", str(envs.snakefile), "-d", str(plan.workdir)]
-    cmd += [*(["--configfile", *plan.configfiles] if plan.configfiles else [])]
+    cmd = _snakemake_cmd(plan.workdir, envs.snakefile, plan.configfiles)
     cmd += ["--rulegraph", "dot", *plan.args.target]
     res = subprocess.run(cmd, env=envs.native, capture_output=True, text=True, check=False)
     rules = set(_LABEL.findall(res.stdout))
     if res.returncode or not rules:
         raise _Abort(f"the rule graph of {plan.args.target} failed: {res.stderr[-2000:]}")
-    scripts = rule_scripts(envs.snakefile)
+    scripts = rule_scripts(envs.snakefile.parent / "workflow")
     return sorted(scripts[r] for r in rules if r in scripts)
 
 
