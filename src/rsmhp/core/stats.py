@@ -33,6 +33,7 @@ from rsmhp.core import guards
 
 __all__ = [
     "DETECTABLE_GRID",
+    "POWER_RULES",
     "ClusterInterval",
     "ExceedanceTest",
     "Improvement",
@@ -40,6 +41,7 @@ __all__ = [
     "binomial_ci",
     "bootstrap_ci",
     "bootstrap_t_ci",
+    "ci_within",
     "cluster_t_ci",
     "detectable_scale",
     "exceedance_test",
@@ -51,6 +53,8 @@ __all__ = [
     "paired_wins",
     "probability_of_improvement",
     "rmse_ci",
+    "rule_power",
+    "rule_runs",
     "runs_for_power",
     "t_power",
     "tost_p_value",
@@ -610,3 +614,96 @@ def probability_of_improvement(
     return Improvement(
         float(per.mean()), float(lo), float(hi), len(wins), float(np.mean(per > 0.5))
     )
+
+
+#: the verdict rules whose prospective power :func:`rule_power` gives
+POWER_RULES = ("equivalence", "non-inferiority", "superiority")
+
+
+def ci_within(n: int, sd: float, effect: float, lower: float, upper: float,
+              level: float = 0.95) -> float:  # fmt: skip
+    r"""The probability that the ``level`` Student-t interval of the mean of ``n`` normal
+    units (true mean ``effect``, sd ``sd``) lies inside ``(lower, upper)`` (``-inf`` and
+    ``inf`` allowed):
+
+    .. math::
+        P\bigl(\text{lower} < \bar d - h,\ \bar d + h < \text{upper}\bigr)
+        = \mathbb E_s\Bigl[\Phi\Bigl(\frac{\text{upper} - h - \mu}{\sigma/\sqrt n}\Bigr)
+          - \Phi\Bigl(\frac{\text{lower} + h - \mu}{\sigma/\sqrt n}\Bigr)\Bigr]^+,
+        \qquad h = t_{n-1,(1+\text{level})/2}\, s/\sqrt n,
+
+    exact for normal units, since :math:`\bar d` and :math:`s` are independent and
+    :math:`(n-1)s^2/\sigma^2 \sim \chi^2_{n-1}`; the expectation over :math:`s` is one
+    numerical integral (``scipy.integrate.quad``, absolute error below 1e-8). ``sd == 0``
+    gives 1 or 0 by whether ``effect`` lies inside. ``n >= 2``."""
+    n = int(guards.integer("n", n, minimum=2))
+    sd, effect = _power_args(sd, effect, level)
+    lower, upper = float(lower), float(upper)
+    if not lower < upper:
+        raise ValueError(f"ci_within: lower {lower!r} must be below upper {upper!r}")
+    if sd == 0:
+        return float(lower < effect < upper)
+    df = n - 1
+    se = sd / np.sqrt(n)
+    crit = float(scipy.stats.t.ppf(0.5 + level / 2, df))
+
+    def inside(u: float) -> float:
+        h = crit * sd * np.sqrt(u / df) / np.sqrt(n)
+        p = scipy.stats.norm.cdf((upper - h - effect) / se)
+        p -= scipy.stats.norm.cdf((lower + h - effect) / se)
+        return max(float(p), 0.0) * float(scipy.stats.chi2.pdf(u, df))
+
+    # above u_max the interval is wider than (lower, upper): nothing to integrate there
+    width = upper - lower
+    u_max = df * (width * np.sqrt(n) / (2 * crit * sd)) ** 2 if np.isfinite(width) else np.inf
+    hi = min(u_max, float(scipy.stats.chi2.ppf(1 - 1e-14, df)))
+    mid = float(df)  # the chi-square's mean: tell quad where the mass is
+    points = [mid] if 0 < mid < hi else None
+    value, _ = scipy.integrate.quad(inside, 0.0, hi, points=points, epsabs=1e-10, limit=200)
+    return float(min(max(value, 0.0), 1.0))
+
+
+def rule_power(rule: str, n: int, sd: float, margin: float, effect: float = 0.0,
+               level: float = 0.95) -> float:  # fmt: skip
+    r"""Prospective power of a claim's verdict rule (:data:`POWER_RULES`) with ``n`` paired
+    units of per-unit sd ``sd`` at a true mean difference ``effect`` (d < 0: the claimed
+    method is better), margin :math:`\Delta` = ``margin`` > 0, the ``level`` t interval
+    (:func:`ci_within`):
+
+    * ``equivalence``: P(interval inside :math:`(-\Delta, \Delta)`) (the rule's "equivalent";
+      TOST at :math:`(1-\text{level})/2` per side);
+    * ``non-inferiority``: P(interval below :math:`+\Delta`) ("supported");
+    * ``superiority``: P(interval below 0 and not inside :math:`(-\Delta, \Delta)`) (the
+      rule's "supported": an interval inside the margin reads "equivalent" first).
+    """
+    margin = float(guards.real("margin", margin, lo=0.0, lo_open=True))
+    if rule == "equivalence":
+        return ci_within(n, sd, effect, -margin, margin, level)
+    if rule == "non-inferiority":
+        return ci_within(n, sd, effect, -np.inf, margin, level)
+    if rule == "superiority":
+        below = ci_within(n, sd, effect, -np.inf, 0.0, level)
+        return max(below - ci_within(n, sd, effect, -margin, 0.0, level), 0.0)
+    raise ValueError(f"rule: {rule!r} (allowed: {', '.join(POWER_RULES)})")
+
+
+def rule_runs(rule: str, sd: float, margin: float, effect: float = 0.0, power: float = 0.8,
+              level: float = 0.95, max_n: int = 100000) -> int | None:  # fmt: skip
+    """The smallest ``n >= 2`` at which :func:`rule_power` reaches ``power`` (it grows with n
+    for every rule at an effect on the rule's side), by doubling then bisection; ``None`` when
+    even ``max_n`` does not reach it (e.g. equivalence at an effect outside the margin)."""
+    power = float(guards.real("power", power, lo=0.0, hi=1.0, lo_open=True, hi_open=True))
+    max_n = int(guards.integer("max_n", max_n, minimum=2))
+
+    def reaches(n: int) -> bool:
+        return rule_power(rule, n, sd, margin, effect, level) >= power
+
+    if not reaches(max_n):
+        return None
+    lo, hi = 1, 2
+    while not reaches(hi):
+        lo, hi = hi, min(2 * hi, max_n)
+    while hi - lo > 1:  # reaches(hi), not reaches(lo) (lo = 1 stands for "below 2")
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if reaches(mid) else (mid, hi)
+    return hi
