@@ -67,6 +67,46 @@ def test_configuration_names_budgets_and_refusals():
         Configuration.from_spec({"maxiter": 3})
 
 
+def test_configuration_names_with_a_start():
+    # the names written before the start existed (committed files hold them) are unchanged
+    assert Configuration("rsmhp_nt64", 30, 3).name == "rsmhp_nt64/it30/r3"
+    assert Configuration("rsmhp_nt64", 30, 3, "warm").name == "rsmhp_nt64/it30/r3"
+    assert Configuration("nbo").name == "nbo" and Configuration("dpw_s30").name == "dpw_s30"
+    assert Configuration("nbo", None, 2).name == "nbo/r2"
+    # a pursuit start: member[/it<maxiter>]/r<restarts>/pursuit
+    assert Configuration("nbo", 30, 3, "pursuit").name == "nbo/it30/r3/pursuit"
+    assert Configuration("rsmhp_nt64", None, 0, "pursuit").name == "rsmhp_nt64/r0/pursuit"
+    assert Configuration("nbo", 30, 0, "pursuit").name == "nbo/it30/r0/pursuit"
+    assert (
+        Configuration("nbo", 30, 3, "pursuit").label() == "NBO (30 it, 3 restarts, pursuit start)"
+    )
+    assert Configuration("nbo", 30, 3).label() == "NBO (30 it, 3 restarts)"
+    # specs: a warm start's is what it was (no key); a pursuit start's round-trips
+    warm = Configuration("rsmhp_nt64", 30, 3)
+    assert warm.spec() == {"member": "rsmhp_nt64", "maxiter": 30, "restarts": 3}
+    assert Configuration.from_spec(warm.spec()) == warm
+    assert Configuration.from_spec({**warm.spec(), "start": "warm"}) == warm
+    pur = Configuration("rsmhp_nt64", 30, 3, "pursuit")
+    assert pur.spec() == {"member": "rsmhp_nt64", "maxiter": 30, "restarts": 3, "start": "pursuit"}
+    assert Configuration.from_spec(pur.spec()) == pur and pur != warm
+    base = UAVSetup.from_config(CONFIG["uav"])
+    assert base.planner.start == "warm"
+    assert pur.setup(base).planner.start == "pursuit"
+    assert warm.setup(pur.setup(base)).planner == warm.setup(base).planner  # start reset
+    assert Configuration("nbo").setup(base).planner == base.planner
+    # refused: an unknown start, a start for a planner without a cost estimate
+    with pytest.raises(ValueError, match=r"start 'cold' \(allowed: 'warm', 'pursuit'\)"):
+        Configuration("nbo", 30, 0, "cold")
+    for member in ("dpw_s30", "pursuit"):
+        assert Configuration(member, start="warm").name == member
+        with pytest.raises(ValueError, match="sampled-cost planners only"):
+            Configuration(member, start="pursuit")
+        with pytest.raises(ValueError, match="sampled-cost planners only"):
+            Configuration.from_spec({"member": member, "start": "pursuit"})
+    with pytest.raises(ValueError, match="may have 'maxiter', 'restarts' and 'start'"):
+        Configuration.from_spec({"member": "nbo", "begin": "pursuit"})
+
+
 def test_candidates_cross_every_sampled_member_with_every_optimiser_budget():
     cfg = {
         "methods": {"nbo": True, "rsmhp_nt": [16, 64], "sigma": True, "dpw": [{"sims": 10}]},
@@ -74,9 +114,48 @@ def test_candidates_cross_every_sampled_member_with_every_optimiser_budget():
     }
     got = protocol.candidates(cfg)
     sampled = [c for c in got if c.family != "dpw"]
-    assert len(sampled) == 3 * 2 * 2 and [c.member for c in got if c.family == "dpw"] == ["dpw_s10"]
-    assert all(c.family != "nbo" for c in got)  # the baseline is not tuned
+    # NBO is tuned like every sampled-cost family: nbo, two RS-MHP members and sigma
+    assert len(sampled) == 4 * 2 * 2 and [c.member for c in got if c.family == "dpw"] == ["dpw_s10"]
+    assert [c.name for c in got if c.family == "nbo"] == [
+        "nbo/it30/r0", "nbo/it30/r2", "nbo/it100/r0", "nbo/it100/r2",
+    ]  # fmt: skip
+    assert all(c.start == "warm" for c in got)  # the default start list
     assert len({c.name for c in got}) == len(got)
+
+
+def test_candidates_with_starts_and_the_pursuit_policy(monkeypatch):
+    cfg = {
+        "methods": {"nbo": True, "rsmhp_nt": [16, 64], "dpw": [{"sims": 10}], "pursuit": True},
+        "optimiser": {"maxiter": [30, 100], "restarts": [0, 3], "start": ["warm", "pursuit"]},
+    }
+    got = protocol.candidates(cfg)
+    names = [c.name for c in got]
+    members, maxiters, restarts, starts = 3, 2, 2, 2
+    assert len(got) == members * maxiters * restarts * starts + 2  # + dpw_s10, pursuit
+    assert len(set(names)) == len(names)
+    assert "nbo/it30/r3" in names and "nbo/it30/r3/pursuit" in names
+    assert names[-2:] == ["dpw_s10", "pursuit"]
+    # table order, then maxiter, then restarts, then start
+    assert names[:8] == [
+        "nbo/it30/r0", "nbo/it30/r0/pursuit", "nbo/it30/r3", "nbo/it30/r3/pursuit",
+        "nbo/it100/r0", "nbo/it100/r0/pursuit", "nbo/it100/r3", "nbo/it100/r3/pursuit",
+    ]  # fmt: skip
+    assert [c.family for c in got[: 3 * 8 : 8]] == ["nbo", "rsmhp", "rsmhp"]
+    assert [c.member for c in got[8:24:8]] == ["rsmhp_nt16", "rsmhp_nt64"]
+    # every run of the tuning once; the untuned reference first
+    conf = protocol.tuning_configurations({"candidates": cfg})
+    assert conf[0] == Configuration("nbo") and conf[1:] == got
+    assert len({c.name for c in conf}) == len(conf)
+    ref = protocol.tuning_configurations(
+        {"candidates": {"methods": {"nbo": True}, "optimiser": {"maxiter": [30], "restarts": [0]}}}
+    )
+    assert [c.name for c in ref] == ["nbo", "nbo/it30/r0"]
+    # the reference among the candidates (a grid with the default budget) is run once
+    monkeypatch.setattr(
+        protocol, "candidates", lambda cfg: [Configuration("nbo"), Configuration("nbo", 30, 1)]
+    )
+    got = protocol.tuning_configurations({"candidates": {}})
+    assert [c.name for c in got] == ["nbo", "nbo/it30/r1"]
 
 
 def _tuning_tables(rng):
@@ -157,6 +236,41 @@ def test_tuned_document_round_trips_into_configurations():
     assert per["1"]["dpw"] == Configuration("dpw_s10")
     with pytest.raises(ValueError, match="no configurations for model 'c'"):
         protocol.tuned_configurations(doc, "c")
+
+
+def test_nbo_is_tuned_as_a_family_and_the_start_reaches_the_tuned_file():
+    """The reference nbo competes with NBO's tuned configurations (select groups by family);
+    a chosen pursuit start is written to the tuned file and read back; a warm start is not
+    written (tuned files written before the start existed read as they did)."""
+    configs = [
+        Configuration("nbo"),
+        Configuration("nbo", 30, 0, "pursuit"),
+        Configuration("rsmhp_nt16", 30, 0),
+        Configuration("rsmhp_nt16", 30, 0, "pursuit"),
+    ]
+    ms = dict(zip([c.name for c in configs], [0.1, 0.5, 0.6, 2.0], strict=True))
+    err = dict(zip([c.name for c in configs], [12.0, 10.0, 11.0, 9.0], strict=True))
+    q = pd.DataFrame([{"model": "a", "config": n, "run": r, "work_per_step": 1.0,
+                       "mean_error": err[n], "plan_ms": ms[n]}
+                      for n in ms for r in range(2)])  # fmt: skip
+    t = pd.DataFrame([{"model": "a", "config": n, "ms": ms[n]} for n in ms for _ in range(3)])
+    sel = protocol.select(q, t, configs, [0.2, 1.0, 4.0])
+    got = {(r.family, r.budget_ms): (r.config, r.start) for r in sel.itertuples()}
+    assert got == {
+        ("nbo", 0.2): ("nbo", "warm"),
+        ("nbo", 1.0): ("nbo/it30/r0/pursuit", "pursuit"),
+        ("nbo", 4.0): ("nbo/it30/r0/pursuit", "pursuit"),
+        ("rsmhp", 1.0): ("rsmhp_nt16/it30/r0", "warm"),
+        ("rsmhp", 4.0): ("rsmhp_nt16/it30/r0/pursuit", "pursuit"),
+    }
+    doc = yaml.safe_load(yaml.safe_dump(protocol.tuned_document(sel, {})))
+    at = doc["chosen"]["a"]
+    assert "start" not in at["0.2"]["nbo"] and "start" not in at["1"]["rsmhp"]
+    assert at["4"]["rsmhp"]["start"] == "pursuit"
+    per = protocol.tuned_configurations(doc, "a")
+    assert per["0.2"]["nbo"] == Configuration("nbo")
+    assert per["1"]["nbo"] == Configuration("nbo", 30, 0, "pursuit")
+    assert per["4"]["rsmhp"] == Configuration("rsmhp_nt16", 30, 0, "pursuit")
 
 
 def _prereg(tmp_path, tuned_sha, **over):

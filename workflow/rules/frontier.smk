@@ -198,6 +198,15 @@ rule frontier_exploratory:
 # frontier.tuning in closed loop and in an interleaved timing on the tuning stream,
 # then the selection rule (rsmhp.pipeline.protocol.select) writes results/tune/tuned.yaml.
 TUNING = FRONTIER["tuning"]
+# the families the tuning runs: frontier.methods' and its candidates' (e.g. the pursuit policy)
+TUNE_FAMILIES = sorted(
+    {
+        *FRONTIER_FAMILIES,
+        *families_of(
+            TUNING["candidates"]["methods"], "frontier.tuning.candidates.methods"
+        ),
+    }
+)
 
 
 rule frontier_tune:
@@ -221,8 +230,8 @@ rule frontier_tune:
         tuning=canonical(TUNING),
         track_loss_error=FRONTIER["track_loss_error"],
         seed=config["seed"],
-        families=FRONTIER_FAMILIES,
-        code=code_digest("workflow/scripts/frontier_tune.py", FRONTIER_FAMILIES),
+        families=TUNE_FAMILIES,
+        code=code_digest("workflow/scripts/frontier_tune.py", TUNE_FAMILIES),
     # closed-loop runs go through the run store (config run_store: the script reads it,
     # it is no param, so moving or disabling the store reruns nothing; docs/store.md)
     script:
@@ -250,8 +259,8 @@ rule frontier_tune_timing:
         models=UAV_MODELS,
         tuning=canonical(TUNING),
         seed=config["seed"],
-        families=FRONTIER_FAMILIES,
-        code=code_digest("workflow/scripts/frontier_tune_timing.py", FRONTIER_FAMILIES),
+        families=TUNE_FAMILIES,
+        code=code_digest("workflow/scripts/frontier_tune_timing.py", TUNE_FAMILIES),
     script:
         "../scripts/frontier_tune_timing.py"
 

@@ -15,10 +15,13 @@ Configurations
 --------------
 A :class:`Configuration` is a registered planning method (its member name, e.g. ``rsmhp_nt256``
 or ``dpw_s300_ka2_ko0p5_ao0``) with the optimiser budget of a sampled-cost planner: at most
-``maxiter`` iterations (``maxfun`` = 2 maxiter + 1 evaluations) and ``restarts`` further
-optimisations from fixed starts (:func:`rsmhp.models.uav.planner.restart_starts`). The random stream
-of a plan is the method's (its ``job_key``): the configurations of one method plan over the
-same hypotheses, so their differences are the optimiser's alone.
+``maxiter`` iterations (``maxfun`` = 2 maxiter + 1 evaluations), ``restarts`` further
+optimisations from fixed starts (:func:`rsmhp.models.uav.planner.restart_starts`) and the
+``start`` of the first optimisation (``"warm"``, the shifted previous plan, or ``"pursuit"``,
+the pursuit policy's plan at the belief: :data:`rsmhp.models.uav.planner.STARTS`). The random
+stream of a plan is the method's (its ``job_key``): the configurations of one method plan over
+the same hypotheses, so their differences are the optimiser's alone. NBO is a sampled-cost
+planner too (one nominal hypothesis) and takes the same knobs.
 
 Tuning rule (:func:`select`)
 ----------------------------
@@ -32,8 +35,11 @@ median alone). For every model, family and budget b (ms per step): among the fam
 candidates whose cost is at most b, the one with the lowest mean closed-loop location error
 over the tuning runs; ties go to the candidate with less work (model steps per step), then to
 the first in candidate order. A family with no candidate within b has no member at b. The
-baseline (NBO) is not tuned: every comparison is against the Monte-Carlo member at the same
-budget.
+baseline family (NBO) is tuned like the others, with the same (maxiter, restarts, start)
+grid; its candidates include the untuned reference ``nbo`` (the default budget), which
+stays the tables' reference (:func:`tuning_configurations` runs it once, first). A family
+without a cost estimate (tree search, pursuit policy) has no optimiser knobs: its members are
+candidates as they are.
 
 Preregistration (:class:`Preregistration`)
 -----------------------------------------
@@ -61,6 +67,7 @@ import yaml
 from rsmhp.core import guards
 from rsmhp.models.uav import methods
 from rsmhp.models.uav.methods.base import Method
+from rsmhp.models.uav.planner import STARTS
 
 __all__ = [
     "CONFIRM_STREAMS",
@@ -102,21 +109,31 @@ def stream_seed(seed: int, stream: str) -> int:
 @dataclass(frozen=True)
 class Configuration:
     """A planning method (``member``: a registered method's name) with its optimiser budget:
-    ``maxiter`` iterations (``None``: the ``uav.planner`` default) and ``restarts``."""
+    ``maxiter`` iterations (``None``: the ``uav.planner`` default), ``restarts`` and the
+    ``start`` of the first optimisation (:data:`rsmhp.models.uav.planner.STARTS`)."""
 
     member: str
     maxiter: int | None = None
     restarts: int = 0
+    start: str = "warm"
 
     def __post_init__(self) -> None:
         methods.from_name(self.member)  # refuses an unknown member, naming the families
         if self.maxiter is not None:
             object.__setattr__(self, "maxiter", guards.positive_int("maxiter", self.maxiter))
         object.__setattr__(self, "restarts", guards.integer("restarts", self.restarts, minimum=0))
-        if not self.method.estimates_cost and (self.maxiter is not None or self.restarts):
+        if self.start not in STARTS:
             raise ValueError(
-                f"configuration {self.member!r}: maxiter and restarts apply to sampled-cost "
-                f"planners only, got maxiter={self.maxiter}, restarts={self.restarts}"
+                f"configuration {self.member!r}: start {self.start!r} (allowed: "
+                f"{', '.join(map(repr, STARTS))})"
+            )
+        if not self.method.estimates_cost and (
+            self.maxiter is not None or self.restarts or self.start != "warm"
+        ):
+            raise ValueError(
+                f"configuration {self.member!r}: maxiter, restarts and start apply to "
+                f"sampled-cost planners only, got maxiter={self.maxiter}, "
+                f"restarts={self.restarts}, start={self.start!r}"
             )
 
     @property
@@ -129,11 +146,17 @@ class Configuration:
 
     @property
     def name(self) -> str:
-        """``member`` alone for the default budget, else ``member/it<maxiter>/r<restarts>``."""
-        if self.maxiter is None and self.restarts == 0:
+        """``member`` alone for the default budget and start (``maxiter`` None, ``restarts``
+        0, ``start`` ``"warm"``); else ``member[/it<maxiter>]/r<restarts>`` (``/it...`` only
+        when ``maxiter`` is set), followed by ``/<start>`` when the start is not ``"warm"``:
+        ``rsmhp_nt64/it30/r3``, ``rsmhp_nt64/r2``, ``nbo/it30/r3/pursuit``,
+        ``rsmhp_nt64/r0/pursuit``. A warm start adds nothing, so every name written before
+        ``start`` existed is unchanged."""
+        if self.maxiter is None and self.restarts == 0 and self.start == "warm":
             return self.member
         it = "" if self.maxiter is None else f"/it{self.maxiter}"
-        return f"{self.member}{it}/r{self.restarts}"
+        start = "" if self.start == "warm" else f"/{self.start}"
+        return f"{self.member}{it}/r{self.restarts}{start}"
 
     def label(self) -> str:
         extra = []
@@ -141,52 +164,73 @@ class Configuration:
             extra.append(f"{self.maxiter} it")
         if self.restarts:
             extra.append(f"{self.restarts} restarts")
+        if self.start != "warm":
+            extra.append(f"{self.start} start")
         return methods.from_name(self.member).label() + (f" ({', '.join(extra)})" if extra else "")
 
     def setup(self, base: Any) -> Any:
-        """``base`` (a :class:`rsmhp.models.uav.simulation.UAVSetup`) with this optimiser budget."""
+        """``base`` (a :class:`rsmhp.models.uav.simulation.UAVSetup`) with this optimiser budget
+        and start."""
         p = base.planner
         maxiter = p.maxiter if self.maxiter is None else self.maxiter
         maxfun = p.maxfun if self.maxiter is None else 2 * self.maxiter + 1
-        planner = dataclasses.replace(p, maxiter=maxiter, maxfun=maxfun, restarts=self.restarts)
+        planner = dataclasses.replace(
+            p, maxiter=maxiter, maxfun=maxfun, restarts=self.restarts, start=self.start
+        )
         return dataclasses.replace(base, planner=planner)
 
     def spec(self) -> dict[str, Any]:
-        return {"member": self.member, "maxiter": self.maxiter, "restarts": self.restarts}
+        """``{"member", "maxiter", "restarts"}``, and ``"start"`` when it is not ``"warm"``
+        (so the spec of a warm-start configuration, a rule's param, is what it was before
+        ``start`` existed)."""
+        out = {"member": self.member, "maxiter": self.maxiter, "restarts": self.restarts}
+        if self.start != "warm":
+            out["start"] = self.start
+        return out
 
     @classmethod
     def from_spec(cls, spec: Mapping[str, Any]) -> Configuration:
-        unknown = set(spec) - {"member", "maxiter", "restarts"}
+        unknown = set(spec) - {"member", "maxiter", "restarts", "start"}
         if unknown or "member" not in spec:
             raise ValueError(
-                f"configuration {dict(spec)!r}: needs 'member', may have 'maxiter' and "
-                f"'restarts' (unknown: {sorted(unknown)})"
+                f"configuration {dict(spec)!r}: needs 'member', may have 'maxiter', "
+                f"'restarts' and 'start' (unknown: {sorted(unknown)})"
             )
-        return cls(str(spec["member"]), spec.get("maxiter"), int(spec.get("restarts", 0)))
+        return cls(
+            str(spec["member"]),
+            spec.get("maxiter"),
+            int(spec.get("restarts", 0)),
+            str(spec.get("start", "warm")),
+        )
 
 
 def tuning_configurations(tuning: Mapping[str, Any]) -> list[Configuration]:
-    """Everything the tuning runs: the baseline (as the tables' reference, not tuned), then
-    :func:`candidates` of ``tuning["candidates"]`` (``frontier.tuning``)."""
-    return [Configuration(methods.baseline()().name), *candidates(tuning["candidates"])]
+    """Everything the tuning runs: the untuned baseline ``nbo`` first (the tables' reference),
+    then :func:`candidates` of ``tuning["candidates"]`` (``frontier.tuning``) but that one
+    (each configuration once). The reference is also a candidate of its family:
+    :func:`select` groups by family, so it competes with the tuned NBO configurations."""
+    reference = Configuration(methods.baseline()().name)
+    return [reference, *(c for c in candidates(tuning["candidates"]) if c != reference)]
 
 
 def candidates(cfg: Mapping[str, Any]) -> list[Configuration]:
     """The tuning candidates of ``frontier.tuning.candidates``: every member of its
-    ``methods`` block; a sampled-cost member once per (maxiter, restarts) of ``optimiser``, a
-    tree search as it is (its budget is its simulations and constants). The baseline family
-    is left out (it is not tuned). Table order, then maxiter, then restarts."""
+    ``methods`` block, the baseline family's (NBO) included; a sampled-cost member once per
+    (maxiter, restarts, start) of ``optimiser`` (``start``: optional, default
+    ``["warm"]``); a member without a cost estimate (tree search: its budget is its
+    simulations and constants; pursuit policy) once, as it is. Table order, then maxiter,
+    then restarts, then start."""
     block = cfg["methods"]
     opt = cfg["optimiser"]
+    starts = opt.get("start", ["warm"])
     out: list[Configuration] = []
     for m in methods.from_config(block, "frontier.tuning.candidates.methods").values():
-        if m.baseline:
-            continue
         if m.estimates_cost:
             out += [
-                Configuration(m.name, int(it), int(r))
+                Configuration(m.name, int(it), int(r), str(st))
                 for it in opt["maxiter"]
                 for r in opt["restarts"]
+                for st in starts
             ]
         else:
             out.append(Configuration(m.name))
@@ -209,6 +253,7 @@ SELECTION_COLUMNS = [
     "member",
     "maxiter",
     "restarts",
+    "start",
     "plan_ms",
     "work_per_step",
     "mean_error",
@@ -275,6 +320,7 @@ def select(
                         "member": c.member,
                         "maxiter": c.maxiter,
                         "restarts": c.restarts,
+                        "start": c.start,
                         "plan_ms": cost[best],
                         "work_per_step": float(q.loc[(model, best), "work_per_step"]),
                         "mean_error": float(q.loc[(model, best), "mean_error"]),
@@ -293,14 +339,17 @@ def file_sha256(path: str | Path) -> str:
 
 def tuned_document(selection: pd.DataFrame, provenance: Mapping[str, Any]) -> dict[str, Any]:
     """The tuned file's content: ``provenance`` and, per model and budget (ms, as text), each
-    family's chosen configuration with its tuning numbers."""
+    family's chosen configuration (its :meth:`Configuration.spec`: ``start`` only when it is
+    not ``"warm"``) with its tuning numbers."""
     chosen: dict[str, dict[str, dict[str, Any]]] = {}
     for r in selection.itertuples(index=False):
         at = chosen.setdefault(str(r.model), {}).setdefault(f"{r.budget_ms:g}", {})
+        start = getattr(r, "start", "warm")
         at[str(r.family)] = {
             "member": str(r.member),
             "maxiter": None if pd.isna(r.maxiter) else int(r.maxiter),
             "restarts": int(r.restarts),
+            **({} if start == "warm" else {"start": str(start)}),
             "tuning": {
                 "plan_ms": round(float(r.plan_ms), 4),
                 "timing_ms": round(float(r.timing_ms), 4),

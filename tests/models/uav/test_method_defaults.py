@@ -30,6 +30,7 @@ from rsmhp.models.uav.methods.monte_carlo import MonteCarlo
 from rsmhp.models.uav.methods.monte_carlo_per_step import MonteCarloPerStep
 from rsmhp.models.uav.methods.nbo import NBO
 from rsmhp.models.uav.methods.pruned_tree import PrunedTree
+from rsmhp.models.uav.methods.pursuit import Pursuit
 from rsmhp.models.uav.methods.rqmc import RQMC
 from rsmhp.models.uav.methods.sigma_points import SigmaPoints
 from rsmhp.models.uav.methods.tree_search import TreeSearch
@@ -47,6 +48,7 @@ BUILT_IN = {
     Antithetic: ("antithetic_nt", "antithetic", r"antithetic_nt(\d+)", _KEYS | _PATTERN),
     SigmaPoints: ("sigma", "cubature", "sigma", {"config_key"} | _PATTERN | _ON_OFF),
     TreeSearch: ("dpw", "dpw", TreeSearch.name_pattern, _KEYS),
+    Pursuit: ("pursuit", "#8b1e3f", "pursuit", {"config_key"} | _PATTERN | _ON_OFF),
 }
 
 

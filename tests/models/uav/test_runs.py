@@ -30,7 +30,7 @@ from rsmhp.models.uav.runs import (
 from rsmhp.models.uav.scoring import run_map_cell
 from rsmhp.models.uav.simulation import UAVSetup, simulate_run
 from rsmhp.pipeline.protocol import Configuration
-from rsmhp.pipeline.runstore import RunStore, key_digest
+from rsmhp.pipeline.runstore import RunStore, canonical_json, key_digest
 from rsmhp.studies.frontier.simulate import run_configurations
 from rsmhp.studies.horizon.simulate_uav import horizon_setup, run_horizon_closed
 from rsmhp.studies.uav.simulate import NONDETERMINISTIC_COLUMNS, run_chunk
@@ -182,6 +182,7 @@ def test_the_key_changes_with_every_part_of_the_setup_method_seed_and_run():
         "horizon": dataclasses.replace(s, planner=dataclasses.replace(s.planner, horizon=4)),
         "maxiter": dataclasses.replace(s, planner=dataclasses.replace(s.planner, maxiter=7)),
         "restarts": dataclasses.replace(s, planner=dataclasses.replace(s.planner, restarts=1)),
+        "start": dataclasses.replace(s, planner=dataclasses.replace(s.planner, start="pursuit")),
         "footprint": dataclasses.replace(
             s, sensor=dataclasses.replace(s.sensor, footprint_radius=150.0)
         ),
@@ -201,6 +202,23 @@ def test_the_key_changes_with_every_part_of_the_setup_method_seed_and_run():
     assert base not in digests.values(), [k for k, v in digests.items() if v == base]
     assert len(set(digests.values())) == len(digests)
     assert _digest() == base  # and it is a function of them: equal parts, equal key
+
+
+def test_a_warm_start_key_is_the_key_before_the_start_existed():
+    """The planner's ``start`` is left out of the key when it is "warm": the canonical text is
+    the setup's with every field but that one (the key of every stored run before the field
+    existed), class tags and field order included; a pursuit start is in the key."""
+    s = _setup()
+    key = closed_loop_key(s, methods.from_name("nbo"), 3, 1)
+    text = canonical_json(key)
+    full = canonical_json({**key, "setup": s})  # the setup with every field
+    assert full.count(',"start":"warm"') == 1 and '"start"' not in text  # sorted: the last
+    assert text == full.replace(',"start":"warm"', "")
+    assert '"__dataclass__":"rsmhp.models.uav.planner.PlannerParams"' in text
+    pursuit = dataclasses.replace(s, planner=dataclasses.replace(s.planner, start="pursuit"))
+    key_p = closed_loop_key(pursuit, methods.from_name("nbo"), 3, 1)
+    assert canonical_json(key_p) == canonical_json({**key_p, "setup": pursuit})
+    assert '"start":"pursuit"' in canonical_json(key_p)
 
 
 def test_the_key_changes_with_the_environment(monkeypatch):

@@ -126,6 +126,7 @@ def test_families_and_the_published_job_keys():
         "antithetic",
         "sigma",
         "dpw",
+        "pursuit",
     ]
     assert methods.baseline().family == "nbo"
     got = methods.from_config(CONFIG["uav"]["methods"], "uav.methods")

@@ -70,7 +70,10 @@ with rollout ``"warm"`` it keeps the warm start (the search as first built); wit
 :math:`D` = ``plan_depth``) with the pursuit policy on the nominal, noise-free propagation,
 :math:`u_j = \pi(b_j)`, :math:`s_{j+1} = f(s_j, u_j)` (the aircraft kinematics),
 :math:`\hat x_{j+1} = F \hat x_j` (the covariance plays no part), for :math:`j = D, \dots,
-H-1`; each of the :math:`H - D - 1` propagations counts as one model step.
+H-1`; each of the :math:`H - D - 1` propagations counts as one model step. With no simulation
+the root has no action (:math:`D = 0`) and the whole plan is this tail from the belief:
+:func:`pursuit_plan`, the plan of the pursuit policy alone
+(:mod:`rsmhp.models.uav.methods.pursuit`) and of the sampled-cost planners' pursuit start.
 
 Counters: ``work`` is the number of calls of :math:`G` (each tree expansion and each rollout
 step; one model step each, as :attr:`rsmhp.models.uav.planner.PlanResult.work` counts) plus the
@@ -94,12 +97,24 @@ from rsmhp.core import numba_cache
 from rsmhp.models.uav import stepper as _stepper
 from rsmhp.models.uav.stepper import _advance
 
-__all__ = ["PURSUIT_TAU", "ROLLOUTS", "SearchResult", "pursuit", "search", "warm_up"]
+__all__ = [
+    "PURSUIT_TAU",
+    "ROLLOUTS",
+    "SearchResult",
+    "pursuit",
+    "pursuit_plan",
+    "pursuit_search",
+    "search",
+    "warm_up",
+]
 
 #: the rollout policies: index = the compiled code's mode (0 warm start, 1 pursuit)
 ROLLOUTS = ("warm", "pursuit")
 #: s, the pursuit policy's range-closing time (see the module docstring)
 PURSUIT_TAU = 10.0
+#: the stream :func:`pursuit_plan` passes to the compiled search, which draws nothing from it
+#: with no simulation (a test checks that its state never moves)
+_NO_DRAWS = np.random.default_rng(0)
 
 
 @njit(cache=True, nogil=True, error_model="numpy")
@@ -447,6 +462,51 @@ def pursuit(uav: np.ndarray, x_hat: np.ndarray, stepper, tau: float = PURSUIT_TA
         out,
     )
     return out
+
+
+def pursuit_plan(
+    uav: np.ndarray,
+    x_hat: np.ndarray,
+    P_hat: np.ndarray,
+    stepper,
+    scale: np.ndarray,
+    horizon: int,
+) -> np.ndarray:
+    r"""The pursuit policy's plan from the belief (``uav``, ``x_hat``, ``P_hat``) over
+    ``horizon`` steps, normalised (H, 2) in :math:`[-1, 1]^2` (controls: the plan times
+    ``scale``). With :math:`s_0` = ``uav``, :math:`\hat x_0` = ``x_hat``, for
+    :math:`j = 0, \dots, H-1`
+
+    .. math::
+        u_j = \pi(s_j, \hat x_j), \qquad s_{j+1} = f(s_j, u_j \cdot \mathrm{scale}), \qquad
+        \hat x_{j+1} = F \hat x_j,
+
+    :math:`\pi` the pursuit action (:func:`pursuit`), :math:`f` the aircraft kinematics
+    (:func:`rsmhp.models.uav.kinematics.step`), the estimate propagated without noise (the
+    closed-loop step with the target at the estimate and no noise: the innovation is 0;
+    ``P_hat`` plays no part in the plan). This is exactly the tail of :func:`search` from the
+    root: :func:`search` with no simulation (the root gets no action, ``plan_depth`` 0), which
+    spends H - 1 nominal propagations (``tail_steps``, its ``work``) and draws no random
+    number (it is passed a stream it never reads). ``stepper`` a
+    :class:`rsmhp.models.uav.stepper.Stepper` of the planning model. Unchecked."""
+    return pursuit_search(uav, x_hat, P_hat, stepper, scale, horizon).plan
+
+
+def pursuit_search(
+    uav: np.ndarray,
+    x_hat: np.ndarray,
+    P_hat: np.ndarray,
+    stepper,
+    scale: np.ndarray,
+    horizon: int,
+) -> SearchResult:
+    """:func:`search` with no simulation, rollout ``"pursuit"``: the :class:`SearchResult`
+    whose plan is :func:`pursuit_plan` (``plan_depth`` 0, ``tail_steps`` H - 1, ``work`` the
+    same)."""
+    return search(
+        uav, x_hat, P_hat, np.zeros((int(horizon), 2)), scale, 0, (0.0, 0.0, 0.0, 0.0, 0.0),
+        stepper, _NO_DRAWS, "pursuit",
+    )  # fmt: skip
 
 
 def search(

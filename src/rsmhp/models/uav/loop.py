@@ -26,7 +26,8 @@ the row. A family says how its hypotheses are made by its class attribute ``clos
 * ``"python"`` (the default: the tree search, plugins, any new family): the Python loop.
 
 A run also takes the Python loop when it has an ``observer`` (recordings), when the setup's
-optimiser is scipy's L-BFGS-B, or when the method's planner is not the default
+optimiser is scipy's L-BFGS-B, when its planner starts from the pursuit plan rather than the
+warm start (``uav.planner.start``), or when the method's planner is not the default
 :class:`rsmhp.models.uav.planner.SampledCostPlanner` with :class:`~rsmhp.models.uav.planner.BoxQN`.
 :func:`path` names the path a run takes and why; ``check_method`` reports it per family.
 
@@ -90,6 +91,10 @@ def path(method: Method, setup, *, observer: bool = False) -> tuple[str, str]:
         return "python", "an observer (recording) sees every step"
     if setup.planner.optimiser != "boxqn":
         return "python", f"optimiser {setup.planner.optimiser!r} (only boxqn is compiled)"
+    if setup.planner.start != "warm":
+        return "python", (
+            f"start {setup.planner.start!r} (the compiled loop starts from the warm start only)"
+        )
     planner = method.planner(setup)
     if type(planner) is not SampledCostPlanner or not isinstance(planner.optimiser, BoxQN):
         return "python", f"the planner is {type(planner).__name__}, not SampledCostPlanner + BoxQN"

@@ -27,7 +27,8 @@ Value and exact gradient :math:`\nabla_x J` come from the compiled kernel
 differences). Both optimisers work on the box, with at most ``maxiter`` iterations and
 ``maxfun`` evaluations (identical for every method), scipy's default tolerances, started from
 the warm start (the previous plan shifted by one step, last control repeated; zeros at the
-first step).
+first step), or with ``uav.planner.start: pursuit`` from the pursuit policy's plan at the
+belief (:func:`rsmhp.models.uav.dpw.pursuit_plan`).
 
 Shared by the studies ``rsmhp.studies.frontier`` and ``rsmhp.studies.horizon`` (so it lives
 below them).
@@ -43,9 +44,10 @@ from typing import TYPE_CHECKING, Any, Protocol, runtime_checkable
 import numpy as np
 
 from rsmhp.core import guards
-from rsmhp.models.uav import fused
+from rsmhp.models.uav import dpw, fused
 from rsmhp.models.uav.kinematics import UAVParams
 from rsmhp.models.uav.sensor import SensorModel
+from rsmhp.models.uav.stepper import Stepper
 from rsmhp.models.uav.target import TargetModel
 
 if TYPE_CHECKING:
@@ -54,6 +56,7 @@ if TYPE_CHECKING:
 __all__ = [
     "LBFGSB",
     "OPTIMISERS",
+    "STARTS",
     "Belief",
     "BoxQN",
     "Optimiser",
@@ -72,12 +75,18 @@ __all__ = [
 
 #: optimiser names of ``PlannerParams.optimiser`` (config ``uav.planner.optimiser``)
 OPTIMISER_NAMES = ("boxqn", "scipy")
+#: the starts of a sampled-cost planner's first optimisation, ``PlannerParams.start`` (config
+#: ``uav.planner.start``): ``"warm"`` the warm start (the shifted previous plan), ``"pursuit"``
+#: the pursuit policy's plan at the belief (:func:`rsmhp.models.uav.dpw.pursuit_plan`)
+STARTS = ("warm", "pursuit")
 
 
 @dataclass(frozen=True)
 class PlannerParams:
-    """Horizon ``H``, optimiser budget (iterations and objective evaluations) and the
-    optimiser (``"boxqn"``: :class:`BoxQN`, ``"scipy"``: :class:`LBFGSB`)."""
+    """Horizon ``H``, optimiser budget (iterations and objective evaluations), the
+    optimiser (``"boxqn"``: :class:`BoxQN`, ``"scipy"``: :class:`LBFGSB`), restarts and the
+    start of the first optimisation (:data:`STARTS`; read by :class:`SampledCostPlanner`
+    only)."""
 
     horizon: int
     maxiter: int
@@ -86,6 +95,9 @@ class PlannerParams:
     #: further optimisations of a sampled-cost planner from fixed starts (:func:`restart_starts`),
     #: beside the one from the warm start; the lowest own cost wins
     restarts: int = 0
+    #: where a sampled-cost planner's first optimisation starts (:data:`STARTS`): the warm
+    #: start, or the pursuit policy's plan at the belief; the restarts are the same either way
+    start: str = "warm"
 
     def __post_init__(self) -> None:
         for name in ("horizon", "maxiter", "maxfun"):
@@ -99,6 +111,10 @@ class PlannerParams:
                 f"PlannerParams.optimiser must be one of {list(OPTIMISER_NAMES)}, "
                 f"got {self.optimiser!r}"
             )
+        if self.start not in STARTS:
+            raise ValueError(
+                f"PlannerParams.start must be one of {list(STARTS)}, got {self.start!r}"
+            )
 
     @classmethod
     def from_config(cls, uav: Mapping[str, Any]) -> PlannerParams:
@@ -110,6 +126,7 @@ class PlannerParams:
             maxfun=p["maxfun"],
             optimiser=p.get("optimiser", "boxqn"),
             restarts=p.get("restarts", 0),
+            start=p.get("start", "warm"),
         )
 
 
@@ -431,7 +448,13 @@ def restart_starts(horizon: int, restarts: int) -> np.ndarray:
 class SampledCostPlanner:
     """The planner of every sampling method: draw the method's weighted hypotheses for the
     belief (``draw(belief, rng)``), build the weighted cost and minimise it with
-    ``optimiser`` (default: the one ``params.optimiser`` names) from the warm start."""
+    ``optimiser`` (default: the one ``params.optimiser`` names) from the warm start, or, with
+    ``params.start == "pursuit"``, from the pursuit policy's plan at the belief
+    (:func:`rsmhp.models.uav.dpw.pursuit_plan` times the control scale; deterministic, it
+    draws nothing); then the ``params.restarts`` restarts (:func:`restart_starts`), the same
+    for either start. ``cost_warm`` is the cost of the first optimisation's start (the warm
+    start's or the pursuit plan's); the pursuit plan's H - 1 nominal propagations are added
+    to ``work``."""
 
     draw: Callable[[Belief, np.random.Generator], Any]
     uav: UAVParams
@@ -443,6 +466,11 @@ class SampledCostPlanner:
     def __post_init__(self) -> None:
         if self.optimiser is None:
             object.__setattr__(self, "optimiser", OPTIMISERS[self.params.optimiser])
+        # the pursuit start's model step, built once per planner (not a field: equality and
+        # the planner's description are the fields')
+        pursue = self.params.start == "pursuit"
+        stepper = Stepper(self.uav, self.target, self.sensor) if pursue else None
+        object.__setattr__(self, "_stepper", stepper)
 
     def plan(
         self, belief: Belief, warm_start: np.ndarray, rng: np.random.Generator | None
@@ -459,7 +487,16 @@ class SampledCostPlanner:
             weights=hyp.weights,
             check=False,
         )
-        res = self.optimiser.minimise(problem, warm_start)
+        start, tail = warm_start, 0
+        if self.params.start == "pursuit":
+            scale = self.uav.control_scale
+            r = dpw.pursuit_search(
+                belief.uav, belief.x_hat, belief.P_hat, self._stepper, scale,
+                self.params.horizon,
+            )  # fmt: skip
+            start, tail = r.plan * scale, r.work
+        res = self.optimiser.minimise(problem, start)
+        res.work += tail
         if self.params.restarts:
             res = _restart(self.optimiser, problem, res, self.params.restarts)
         res.hypotheses = hyp
@@ -471,7 +508,8 @@ def _restart(
 ) -> PlanResult:
     """The best of ``first`` and ``restarts`` optimisations from :func:`restart_starts` (the
     lowest own cost; ties keep the earlier), with the work and iterations of all of them and
-    ``diagnostics["restart"]`` = which one won (0: the warm start)."""
+    ``diagnostics["restart"]`` = which one won (0: the first optimisation, from the warm
+    start or the pursuit plan)."""
     best, work, nit = first, first.work, first.nit
     winner = 0
     starts = restart_starts(problem.params.horizon, restarts)

@@ -11,7 +11,9 @@ on (seed, run, the method's ``job_key``), so a run is a function of
 
 * the **setup**: every field of the :class:`~rsmhp.models.uav.simulation.UAVSetup`, its nested
   frozen dataclasses (aircraft, target, sensor, planner with horizon and optimiser budget) and
-  arrays (``P0``: dtype, shape and every bit) and the scenario ranges;
+  arrays (``P0``: dtype, shape and every bit) and the scenario ranges; the planner's
+  ``start`` only when it is not the default ``"warm"`` (:func:`_key_setup`: a run from the
+  warm start has the key it had before the field existed);
 * the **method**: its family, class and :meth:`~rsmhp.models.uav.methods.Method.spec`;
 * the **seed** and the **run** index;
 * the **code**: :func:`closed_loop_code`, the digest (:mod:`rsmhp.pipeline.code_digest`) of
@@ -41,6 +43,7 @@ Shared by the studies ``rsmhp.studies.frontier``, ``rsmhp.studies.horizon`` and
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import logging
 import os
@@ -132,6 +135,31 @@ def environment() -> dict[str, Any]:
     }
 
 
+def _tagged(value: Any, fields: dict[str, Any]) -> dict[str, Any]:
+    """The dataclass ``value`` as the store's canonical form writes one
+    (:func:`rsmhp.pipeline.runstore.canonical_json`: its class and its fields), with
+    ``fields`` in place of its own."""
+    cls = type(value)
+    return {"__dataclass__": f"{cls.__module__}.{cls.__qualname__}", "fields": fields}
+
+
+def _key_setup(setup: UAVSetup) -> Any:
+    """The setup as the key holds it: ``setup`` itself, except that a planner with the
+    default ``start`` (``"warm"``) is written without that field, so the key's canonical
+    text is the one it had before ``PlannerParams.start`` existed; any other start is a
+    field of the key like the rest."""
+    planner = setup.planner
+    if planner.start != "warm":
+        return setup
+    own = {f.name: getattr(setup, f.name) for f in dataclasses.fields(setup)}
+    own["planner"] = _tagged(
+        planner,
+        {f.name: getattr(planner, f.name) for f in dataclasses.fields(planner)
+         if f.name != "start"},
+    )  # fmt: skip
+    return _tagged(setup, own)
+
+
 def closed_loop_key(setup: UAVSetup, method: Method, seed: int, run: int) -> dict[str, Any]:
     """The store key of run ``run`` of ``method`` on ``setup`` with root seed ``seed`` (see
     the module docstring); a family outside the registry is refused (it cannot be stored)."""
@@ -146,7 +174,7 @@ def closed_loop_key(setup: UAVSetup, method: Method, seed: int, run: int) -> dic
     cls = type(method)
     return {
         "kind": NAMESPACE,
-        "setup": setup,
+        "setup": _key_setup(setup),
         "method": {
             "family": method.family,
             "class": f"{cls.__module__}.{cls.__qualname__}",

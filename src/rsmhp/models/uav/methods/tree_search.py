@@ -194,7 +194,7 @@ class TreeSearch(Method):
             "optionally, search constants (defaults: the constants fixed before any run)."
         ),
         "type": "array",
-        "maxItems": 10,
+        "maxItems": 20,
         "items": {
             "type": "object",
             "additionalProperties": False,
