@@ -35,7 +35,7 @@ help:
 	@echo "rsmhp: replication pipeline (RS-MHP vs NBO). Targets:"
 	@echo "  make replicate [ARGS=...]  set up .venv if needed, run the full replication (snakemake -j$(CORES) ARGS)"
 	@echo "  make tune [ARGS=...]       the protocol's tuning (tuning stream; not in replicate), then"
-	@echo "                             copy results/tune/tuned.yaml to config/tuned.yaml"
+	@echo "                             copy results/tune/tuned.yaml to $(TUNED), its tables to $(TUNING_DIR)/"
 	@echo "  make verify [ARGS=...]     run what is missing, compare every claim with paper/claims.json"
 	@echo "  make compare PLUGIN_METHODS=a,b  new planners paired with the published reference (docs/compare.md)"
 	@echo "  make portability [ARGS=...] rerun as on another CPU (numba generic, OpenBLAS Nehalem, no"
@@ -74,12 +74,18 @@ replicate: $(STAMP)
 	$(BIN)/snakemake -j$(CORES) $(ARGS)
 
 # the protocol's tuning on its own seed stream (not part of replicate): every candidate in closed
-# loop and in an interleaved timing, the selection rule, and the tuned file copied to config/
-# (tracked: a new preregistration must follow before the next confirmatory run)
+# loop and in an interleaved timing, the selection rule, and the tuned file copied to TUNED
+# with the tuning tables beside it in TUNING_DIR (tracked: a new preregistration must follow
+# before the next confirmatory run). The default is the third tuning's: config/tuned.yaml is
+# the file the second preregistration names, and the published run depends on it.
+TUNED ?= config/tuned_v3.yaml
+TUNING_DIR ?= paper/tuning_v3
 tune: $(STAMP)
 	$(BIN)/snakemake -j$(CORES) tune $(ARGS)
-	cp results/tune/tuned.yaml config/tuned.yaml
-	@echo "config/tuned.yaml written: write and commit a new config/preregistration.yaml before the confirmatory run"
+	cp results/tune/tuned.yaml $(TUNED)
+	mkdir -p $(TUNING_DIR)
+	cp results/tune/selection.csv results/tune/candidates.csv results/tune/tuning.md results/tune/depth.md $(TUNING_DIR)/
+	@echo "$(TUNED) and $(TUNING_DIR)/ written: write and commit a new preregistration before the confirmatory run"
 
 # copy the report of results/ into the tracked paper/ (the only target that changes tracked files)
 # copy the report, its claims (the reference of make verify) and the README's glance table,

@@ -274,6 +274,8 @@ rule frontier_tune_select:
         tuned="results/tune/tuned.yaml",
         selection="results/tune/selection.csv",
         table="results/tune/tuning.md",
+        candidates="results/tune/candidates.csv",
+        depth="results/tune/depth.md",
     log:
         "results/logs/frontier_tune_select.log",
     conda:

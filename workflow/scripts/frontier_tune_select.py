@@ -11,6 +11,7 @@ from rsmhp.pipeline.script import rule_logging
 from rsmhp.report.markdown import markdown_table
 from rsmhp.report.provenance import provenance
 from rsmhp.studies.frontier.simulate import config_runs_contract, config_timing_contract
+from rsmhp.studies.frontier.tuning import candidate_table, depth_table
 
 with rule_logging(snakemake) as log:
     p = snakemake.params
@@ -59,5 +60,16 @@ with rule_logging(snakemake) as log:
     write_csv(selection, snakemake.output.selection)
     write_text(
         markdown_table(selection, digits=4, missing="default") + "\n", snakemake.output.table
+    )
+    cands = candidate_table(quality, timing, tuned)
+    write_csv(cands, snakemake.output.candidates)
+    depth = depth_table(quality, cands)
+    write_text(
+        "What depth buys, on the tuning stream: every tree search and the pursuit policy alone "
+        "(plan depth 0); diff_pursuit = mean error − the pursuit policy's, paired over the "
+        "tuning runs (m, 95% t interval).\n\n"
+        + markdown_table(depth, digits=3, missing="—")
+        + "\n",
+        snakemake.output.depth,
     )
     log.info("%d (model, family, budget) selections from %d candidates", len(selection), len(tuned))
