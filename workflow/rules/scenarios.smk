@@ -70,6 +70,11 @@ rule scenarios_summary:
     params:
         n_boot=config["scenarios"]["bootstrap"],
         seed=config["seed"],
+        # the seed streams of the groups' runs, named in the appendix
+        streams={
+            "equal compute": CONFIRM["stream"] if CONFIRM is not None else None,
+            "long horizons": config["horizon"]["stream"],
+        },
         code=code_digest("workflow/scripts/scenarios_summary.py"),
     script:
         "../scripts/scenarios_summary.py"

@@ -38,5 +38,5 @@ with rule_logging(snakemake) as log:
     write_csv(summary, snakemake.output.summary)
     for path in snakemake.output.tables:
         write_text(tables[Path(path).stem] + "\n", path)
-    scenarios_section(summary, tables, best).save(snakemake.output.section)
+    scenarios_section(summary, tables, best, p.streams).save(snakemake.output.section)
     log.info("%d scenario rows, %d summary rows", len(per), len(summary))

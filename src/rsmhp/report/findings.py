@@ -26,6 +26,7 @@ from typing import Any
 
 import pandas as pd
 
+from rsmhp.report.disclosures import verdict_note
 from rsmhp.report.ledger import STATEMENT_VERDICTS, Claim
 from rsmhp.report.markdown import fmt, fmt_ci, param_text
 from rsmhp.report.power import runs_needed
@@ -155,7 +156,16 @@ def verdict_text(c: Claim) -> str:
     """The verdict as it reads: ``equivalent (difference significant but below Δ = 0.25 m)``
     when the CI of an equivalent key number excludes its null; ``inconclusive (after Holm,
     p = 0.0512; equivalent without it)`` when Holm's correction made it inconclusive; else
-    the verdict."""
+    the verdict; followed by the note of a choice made after its data
+    (:func:`rsmhp.report.disclosures.verdict_note`), e.g. ``equivalent (exploratory: margin
+    set after the first result)``."""
+    note = verdict_note(c)
+    text = _verdict_words(c)
+    return WORDS("with_note", verdict=text, note=note) if note else text
+
+
+def _verdict_words(c: Claim) -> str:
+    """:func:`verdict_text` without the disclosures' note."""
     k = c.key
     m = _HOLM.search(c.rule)
     if c.verdict == "inconclusive" and m:
@@ -251,15 +261,41 @@ def best_sentence(best: pd.DataFrame | None) -> str:
     return "; ".join(parts)
 
 
+def other_streams(
+    claims: Sequence[Claim], history: pd.DataFrame | None, appendix: str = "appendix.md"
+) -> list[dict[str, Any]]:
+    """Per earlier seed stream of ``history`` (rows of kind ``stream``, e.g. a superseded
+    confirmatory run) that judged some of ``claims``: its label and the claims it judged
+    otherwise ({label, claims: [linked id, its verdict there]}), in the history's order. The
+    main text says so next to the claims, not only in the fragility list."""
+    if history is None or history.empty:
+        return []
+    by_id = {c.id: c for c in claims}
+    rows = history[(history["kind"] == "stream") & history["claim"].isin(list(by_id))]
+    out = []
+    for label, g in rows.groupby("label", sort=False):
+        other = [
+            (link(r.claim, appendix), r.verdict)
+            for r in g.itertuples(index=False)
+            if r.verdict != by_id[r.claim].verdict
+        ]
+        if other:
+            out.append({"label": str(label), "n": len(g), "claims": other})
+    return out
+
+
 def found_values(
     judgements: Sequence[Judgement],
     claims: Sequence[Claim],
     best: pd.DataFrame | None = None,
     appendix: str = "appendix.md",
+    history: pd.DataFrame | None = None,
 ) -> Mapping[str, Any]:
     """The values the "What we found" template fills in: the statements by verdict on the
-    paper's setups and on variants, the claims each sentence names (linked, with key number
-    and verdict), the best-family summary and the checks' count."""
+    paper's setups and on variants, the claims each sentence names (linked, with key number,
+    verdict and contrary evidence where a claim has some), the FR claims whose verdict another
+    seed stream of ``history`` gave otherwise (:func:`other_streams`), the best-family
+    summary and the checks' count."""
     by_id = {c.id: c for c in claims}
 
     def phrase(cid: str) -> str:
@@ -275,7 +311,11 @@ def found_values(
         got = [(lab, by_id[cid]) for lab, cid in m.setups if cid in by_id]
         if not got:
             return ""
-        inner = "; ".join(f"{lab}: {_claim_phrase(c, appendix)}" for lab, c in got)
+        inner = "; ".join(
+            f"{lab}: {_claim_phrase(c, appendix)}"
+            + (" " + WORDS("contrary_inline", text=c.contrary) if c.contrary else "")
+            for lab, c in got
+        )
         return f"'{m.says}' ({inner})"
 
     return {
@@ -285,6 +325,11 @@ def found_values(
         "statement": {j.statement.id: j for j in judgements},
         "claim": phrase,
         "fr": [p for m in fr if (p := row_phrase(m))],
+        "fr_streams": other_streams(
+            [c for m in fr for _, cid in m.setups if (c := by_id.get(cid)) is not None],
+            history,
+            appendix,
+        ),
         "hz": [p for m in hz if (p := row_phrase(m))],
         "best": best_sentence(best),
         "n_checks": len(checks),

@@ -24,6 +24,7 @@ from typing import Any
 import pandas as pd
 import yaml
 
+from rsmhp.report.disclosures import disclosure_lines
 from rsmhp.report.findings import MAIN_CLAIMS, found_values, key_text, link, main_rows, verdict_text
 from rsmhp.report.history import fragility
 from rsmhp.report.ledger import STATEMENT_VERDICTS, VERDICTS, Claim, Section
@@ -178,13 +179,15 @@ def what_we_found(
     statements: Sequence[Statement] | None = None,
     best: pd.DataFrame | None = None,
     appendix: str = "appendix.md",
+    history: pd.DataFrame | None = None,
 ) -> str:
     """The "What we found" sentences (numbered Markdown) of the main text, from the claims
-    of ``sections``, their statements' judgements and the best-family table ``best``."""
+    of ``sections``, their statements' judgements, the best-family table ``best`` and the
+    earlier judgements ``history`` (:func:`rsmhp.report.history.load_history`)."""
     sections = sorted(sections, key=lambda s: (s.order, s.key))
     claims = [c for s in sections for c in s.claims]
     judgements, _ = judge_all(claims, statements)
-    values = found_values(judgements, claims, best, appendix)
+    values = found_values(judgements, claims, best, appendix, history)
     return render_template("rsmhp.report", "findings.md", **values).strip()
 
 
@@ -223,6 +226,7 @@ def _main_claims_values(
         "n_other": sum(1 for c in claims if c.id not in shown and not c.check),
         "n_checks": sum(c.check for c in claims),
         "fragile": fragile,
+        "after_data": disclosure_lines(claims),
     }
 
 
@@ -268,7 +272,7 @@ def render_report(
         n_claims=len(claims),
         n_bitwise=n_bit,
         n_statistical=len(claims) - n_bit,
-        found=what_we_found(sections, statements, best, appendix),
+        found=what_we_found(sections, statements, best, appendix, history),
         figure=SUMMARY_FIGURE if any(SUMMARY_FIGURE in s.figures for s in sections) else "",
         caption=SUMMARY_CAPTION,
         **_statements_values(judgements, untested, appendix),

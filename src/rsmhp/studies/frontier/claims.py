@@ -469,12 +469,7 @@ def _ladder_against(c: Comparison, lad: pd.DataFrame, verdict: str) -> list[dict
     out = []
     for r in other.itertuples(index=False):
         lo, hi = r.diff_mc_low, r.diff_mc_high
-        against = {
-            "equivalent": lo < -c.margin or hi > c.margin,
-            "supported": lo > bound,
-            "not supported": hi < bound,
-        }.get(verdict, hi < bound or lo > bound)
-        if against:
+        if _against_verdict(verdict, lo, hi, c.margin, bound):
             diff, ci = fmt(r.diff_mc, 3, True), fmt_ci(lo, hi, 3, True)
             budget = param_text(r.budget_ms)
             out.append(
@@ -487,6 +482,58 @@ def _ladder_against(c: Comparison, lad: pd.DataFrame, verdict: str) -> list[dict
                 }
             )
     return out
+
+
+def _against_verdict(verdict: str, lo: float, hi: float, margin: float, bound: float) -> bool:
+    """Whether a CI [lo, hi] of d lies where ``verdict`` says it does not: above ``bound``
+    where the verdict is "supported", below it where "not supported", outside ±margin where
+    "equivalent", off ``bound`` either way where "inconclusive"."""
+    return {
+        "equivalent": lo < -margin or hi > margin,
+        "supported": lo > bound,
+        "not supported": hi < bound,
+    }.get(verdict, hi < bound or lo > bound)
+
+
+def _configuration(row: Any) -> Configuration:
+    """The configuration of a confirmatory run's row (member, maxiter or NaN, restarts)."""
+    from rsmhp.pipeline.protocol import Configuration
+
+    maxiter = None if pd.isna(row.maxiter) else int(row.maxiter)
+    return Configuration(str(row.member), maxiter, int(row.restarts))
+
+
+def comparator_members(
+    c: Comparison, runs: pd.DataFrame, summary: pd.DataFrame, verdict: str
+) -> list[dict[str, Any]]:
+    """The claim's family member against every other member of the comparator's family the
+    run holds on the claim's model (other budgets' members of the ladder; a secondary result
+    computed after the data, not preregistered): per member its label, closed-loop time per
+    step (``loop``, and ``over`` when above the budget), d = error of ``c.a`` − that member
+    paired over runs with its 95% t interval, and ``opposite`` when that interval lies where
+    the claim's verdict says it does not (the sign depends on which member is compared)."""
+    rows = runs[(runs["model"] == c.model) & (runs["family"] == c.b.family)]
+    firsts = rows.drop_duplicates("config").sort_values("config")
+    bound = 0.0 if c.superiority else c.margin
+    out = []
+    for row in firsts.itertuples(index=False):
+        if row.config == c.b.name:
+            continue
+        d = paired_configs(runs, c.model, c.a.name, str(row.config))
+        loop = float(summary.loc[(c.model, row.config), "loop_ms"])
+        out.append(
+            {
+                "label": _configuration(row).label(),
+                "loop": fmt(loop, 3),
+                "over": loop > c.budget_ms,
+                "better": float(d.mean) < 0,
+                "diff": fmt(float(d.mean), 3, True),
+                "ci": fmt_ci(float(d.low), float(d.high), 3, True),
+                "opposite": _against_verdict(verdict, d.low, d.high, c.margin, bound),
+                "loop_ms": loop,
+            }
+        )
+    return sorted(out, key=lambda m: m["loop_ms"])
 
 
 def _depth(row: pd.Series) -> dict[str, str]:
@@ -517,6 +564,7 @@ def confirm_evidence(
     pi = prob_improvement(wide[c.a.name].to_numpy(), wide[c.b.name].to_numpy())
     ra, rb = summary.loc[(c.model, c.a.name)], summary.loc[(c.model, c.b.name)]
     family, against = c.labels
+    members = comparator_members(c, runs, summary, verdict)
     # a superiority rule's equivalence margin; a non-inferiority rule's margin is the null
     key = KeyNumber(WORDS("confirm_key", family=family, against=against), float(d.mean),
                     float(d.low), float(d.high), unit="m", reproducible="statistical", digits=3,
@@ -545,7 +593,10 @@ def confirm_evidence(
         "loop_a": fmt(float(ra["loop_ms"]), 3),
         "loop_b": fmt(float(rb["loop_ms"]), 3),
         "depth": _depth(ra) if c.a.family == "dpw" else None,
-        "contrary": _over_budget(c, summary) + _ladder_against(c, lad, verdict),
+        "members": members,
+        "contrary": _over_budget(c, summary)
+        + _ladder_against(c, lad, verdict)
+        + [{"kind": "member", "against": against, **m} for m in members if m["opposite"]],
     }
     return Evidence(key=key, facts=paired_facts(d), values=values, rule=rule)
 

@@ -8,6 +8,7 @@ module."""
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
 
@@ -238,13 +239,19 @@ def _render(template: str, **values: Any) -> str:
     return render(__package__, template, **values).removesuffix("\n")
 
 
-def scenarios_section(summary: pd.DataFrame, tables: dict[str, str], best: pd.DataFrame) -> Section:
+def scenarios_section(
+    summary: pd.DataFrame,
+    tables: dict[str, str],
+    best: pd.DataFrame,
+    streams: Mapping[str, str | None] | None = None,
+) -> Section:
     """The section (order :data:`ORDER`; text in ``section.md`` and ``appendix.md``): in the
     main text the best method per cell of each group (``best``,
     :data:`rsmhp.studies.scenarios.best.BEST_COLUMNS`), then the probability of improvement
     over NBO of every method on each group of scenarios with its figure; in the appendix the
     best-method figure (listed in ``figures``: the report's main text opens with it,
-    :data:`rsmhp.report.render.SUMMARY_FIGURE`) and the tables."""
+    :data:`rsmhp.report.render.SUMMARY_FIGURE`), the tables and the seed stream of each
+    group's runs (``streams``: group -> stream name, e.g. ``{"equal compute": "confirm2"}``)."""
     groups = [g for g in dict.fromkeys(summary["group"]) if g != ALL_GROUP]
     best_groups = [g for g in GROUPS if g in set(best["group"])]
     best_groups += [g for g in dict.fromkeys(best["group"]) if g not in best_groups]
@@ -266,5 +273,6 @@ def scenarios_section(summary: pd.DataFrame, tables: dict[str, str], best: pd.Da
             best_table=tables["scenarios_best"],
             improvement_table=tables["scenarios_improvement"],
             per_scenario_table=tables["scenarios_per_scenario"],
+            streams=dict(streams or {}),
         ),
     )  # fmt: skip

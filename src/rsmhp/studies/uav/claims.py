@@ -65,7 +65,8 @@ SETUP = WORDS("setup")
 
 def paired_rule(a: str, b: str, margin: float) -> Rule:
     """The rule of "``a`` has lower error than ``b``" (short method names, printed), with the
-    equivalence margin ±``margin`` (m), fixed in the config before the run."""
+    equivalence margin ±``margin`` (m), from the config (set after a first published result:
+    :mod:`rsmhp.report.disclosures`)."""
     return ci_side(
         KEY,
         0.0,
