@@ -84,7 +84,7 @@ def test_undecidable_and_missing():
     assert runs_text(KeyNumber("x", 1.0, 0.5, 1.5, null=0.0)) == "–"
     assert runs_text(_key(0.0, 0.1, 10)) == "10 (no number of runs decides it)"
     n = runs_needed(_key(0.3, 1 / math.sqrt(20), 20))
-    assert runs_text(_key(0.3, 1 / math.sqrt(20), 20)) == f"20 ({n} at 80% power)"
+    assert runs_text(_key(0.3, 1 / math.sqrt(20), 20)) == f"20 (post hoc: {n} at 80% power)"
 
 
 @pytest.mark.parametrize("bad", [dict(n=1), dict(n=2.5), dict(margin=0.0), dict(margin=-1.0)])

@@ -89,8 +89,9 @@ def test_main_claims_take_their_words_from_the_template() -> None:
 
 def test_power_and_best_read_as_sentences() -> None:
     words = findings.WORDS
-    assert words("power", n=80, need=320, holm=True) == "n = 80, 320 for 80% power before Holm"
-    assert words("power", n=80, need=320, holm=False) == "n = 80, 320 for 80% power"
+    with_holm = "n = 80, post hoc 320 for 80% power before Holm"
+    assert words("power", n=80, need=320, holm=True) == with_holm
+    assert words("power", n=80, need=320, holm=False) == "n = 80, post hoc 320 for 80% power"
     assert words("power_undecided", n=5) == "n = 5, no n decides it at this estimate"
     cells = words("best_at", method="tree", cells="H = " + words("span", first="2", last="24"))
     assert words("best_by", group="horizon", model="paper", cells=cells) == (

@@ -29,6 +29,7 @@ import pandas as pd
 from rsmhp.report.disclosures import verdict_note
 from rsmhp.report.ledger import STATEMENT_VERDICTS, Claim
 from rsmhp.report.markdown import fmt, fmt_ci, param_text
+from rsmhp.report.naming import depth_of
 from rsmhp.report.power import runs_needed
 from rsmhp.report.statements import Judgement
 from rsmhp.report.templates import Words
@@ -199,8 +200,10 @@ def main_rows(claims: Sequence[Claim], appendix: str = "appendix.md") -> list[di
             c = by_id.get(cid)
             if c is None:
                 continue
+            depth = depth_of(c.claim)  # a tree search named by its measured plan depth
+            named = f"**{label}** ({depth})" if depth else f"**{label}**"
             cells.append(
-                f"**{label}** {link(cid, appendix)}: {key_text(c)} → **{verdict_text(c)}**"
+                f"{named} {link(cid, appendix)}: {key_text(c)} → **{verdict_text(c)}**"
                 f"{_power_text(c)}"
             )
         if cells:

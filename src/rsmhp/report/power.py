@@ -87,12 +87,13 @@ def runs_needed(key: KeyNumber, power: float = POWER) -> int | None:
 
 
 def runs_text(key: KeyNumber, power: float = POWER) -> str:
-    """``"80 (320 at 80% power)"``: the units this run had and the units needed (``before
-    Holm`` for a claim of Holm's family), or ``–``."""
+    """``"80 (post hoc: 320 at 80% power)"``: the units this run had and the units needed
+    if the true difference were the estimate (``before Holm`` for a claim of Holm's family),
+    or ``–``. Post hoc: computed from the data it describes, not the design's power."""
     need = runs_needed(key, power)
     if key.n is None:
         return "–"
     if need is None:
         return f"{key.n} (no number of runs decides it)"
     holm = ", before Holm" if key.p_holm is not None else ""
-    return f"{key.n} ({need} at {power:.0%} power{holm})"
+    return f"{key.n} (post hoc: {need} at {power:.0%} power{holm})"

@@ -16,6 +16,7 @@ from scipy import stats as sps
 
 from rsmhp.core.stats import probability_of_improvement
 from rsmhp.report.markdown import fmt
+from rsmhp.report.palette import method_label
 from rsmhp.studies.scenarios.best import BEST_RUN_COLUMNS, best_family
 from rsmhp.studies.scenarios.figures import improvement_figure
 from rsmhp.studies.scenarios.section import scenarios_section, scenarios_tables
@@ -160,10 +161,19 @@ def test_section_and_figure_read_the_summary():
     tables = scenarios_tables(s, per_scenario(runs), empty.cells, empty.paired)
     sec = scenarios_section(s, tables, empty.cells)
     assert sec.key == "scenarios" and not sec.claims
-    assert f"{MAP_GROUP} (2, 2 methods)" in sec.body
-    assert f"{HORIZON_GROUP} (3, 2 methods)" in sec.body
-    top = s[s.group == HORIZON_GROUP].sort_values("p_improve").iloc[-1]  # the highest
-    assert f"{fmt(top.p_improve, 2)} [{fmt(top.low, 2)}, {fmt(top.high, 2)}]" in sec.body
+    assert f"{MAP_GROUP} (2 scenarios): " in sec.body
+    assert f"{HORIZON_GROUP} (3 scenarios): " in sec.body
+    # every method with its probability and, beside it, its mean difference in metres (the
+    # mean over scenarios of the scenario's paired mean difference) in the table's order
+    per = per_scenario(runs)
+    for r in s[s.group != ALL_GROUP].itertuples(index=False):
+        mine = per[(per.method == r.method) & (per.group == r.group)]["mean_diff"]
+        assert r.mean_diff == pytest.approx(mine.mean())
+        assert r.worse_scenarios == int((mine > 0).sum())
+        text = (f"{method_label(r.method)} {fmt(r.p_improve, 2)} [{fmt(r.low, 2)}, "
+                f"{fmt(r.high, 2)}], {fmt(r.mean_diff, 3, True)} m")  # fmt: skip
+        assert text in sec.body
+    assert "highest" not in sec.body and "lowest" not in sec.body.split("Which")[-1]
     assert tables["scenarios_improvement"] in sec.appendix
     fig = improvement_figure(s)
     try:

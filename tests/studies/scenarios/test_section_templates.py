@@ -91,17 +91,16 @@ def test_the_prose_is_complete(data):
     assert sec.figures == ["scenarios_improvement"]
     assert sec.appendix.startswith("Best method per cell (figure scenarios_best): in every cell")
     assert sec.body.startswith("P(a method's closed-loop run beats NBO's paired run), mean over")
-    assert f"(appendix: every method): {MAP_GROUP} (2, 2 methods): highest " in sec.body
-    assert f"; {HORIZON_GROUP} (3, 2 methods): highest " in sec.body
-    assert ". Wins, not metres: most runs can be won by centimetres (UAV-2: equivalent).\n\n" in (
-        sec.body
-    )
+    assert f"(appendix: every scenario): {MAP_GROUP} (2 scenarios): " in sec.body
+    assert f". {HORIZON_GROUP} (3 scenarios): " in sec.body
+    assert "neither ranks the methods alone" in sec.body and "highest" not in sec.body
     assert sec.body.endswith("bars: 95% stratified bootstrap.*")
     assert sec.appendix.endswith(tables["scenarios_per_scenario"])
     assert f"\n\n{tables['scenarios_improvement']}\n\nPer scenario:\n\n" in sec.appendix
     # a group with one method names it once; no data: one sentence
     one = section.scenarios_section(summary.groupby("group").head(1), tables, best.iloc[:0])
-    assert f"{MAP_GROUP} (2): " in one.body and "highest" not in one.body
+    assert f"{MAP_GROUP} (2 scenarios): " in one.body
+    assert "; " not in one.body.split(MAP_GROUP)[1].split(". ")[0]  # one method
     empty = section.scenarios_section(summary.iloc[:0], tables, best.iloc[:0])
     assert empty.body.startswith("No scenario has paired closed-loop runs of a method and NBO.\n\n")
 
@@ -112,8 +111,8 @@ def test_a_missing_value_is_an_error(rendered):
             rest = {k: v for k, v in values.items() if k != missing}
             with pytest.raises(jinja2.UndefinedError, match=f"'{missing}' is undefined"):
                 render(PACKAGE, name, **rest)
-    group = {"group": "g", "scenarios": 2, "methods": 2, "lowest": None}  # no "highest"
-    with pytest.raises(jinja2.UndefinedError, match="highest"):
+    group = {"group": "g", "scenarios": 2}  # no "methods"
+    with pytest.raises(jinja2.UndefinedError, match="methods"):
         render(PACKAGE, "section.md", best=[], empty=False, groups=[group])
 
 

@@ -110,6 +110,7 @@ MAP_RUN_COLUMNS = [
     "final_error",
     "detect_rate",
     "lost",
+    "plan_depth",
 ]
 
 
@@ -161,7 +162,7 @@ def map_contracts(cfg: Mapping[str, Any], cell: str) -> tuple[Contract, Contract
         text=("cell", "method"),
         boolean=("lost",),
         integer=("run",),
-        nullable=("row_value", "col_value"),
+        nullable=("row_value", "col_value", "plan_depth"),
         keys=("method", "run"),
         expected=pd.DataFrame(keys, columns=["method", "run"]),
         values={"cell": cell},
@@ -461,6 +462,8 @@ def run_map_cell(
             "final_error": s["final_error"],
             "detect_rate": s.get("detect_rate", 1.0),
             "lost": bool(s["final_error"] > loss),
+            # a tree search's mean plan depth over the run's steps (empty for the others)
+            "plan_depth": s.get("diagnostics", {}).get("plan_depth", float("nan")),
         }
         for s in summaries
     ]

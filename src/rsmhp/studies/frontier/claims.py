@@ -49,6 +49,7 @@ from rsmhp.models.uav.methods.tree_search import TreeSearch
 from rsmhp.report.claimspec import ClaimSpec, Evidence
 from rsmhp.report.ledger import Claim, KeyNumber
 from rsmhp.report.markdown import fmt, fmt_ci, param_text
+from rsmhp.report.naming import depth_name
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import Words
 from rsmhp.report.verdicts import Rule, ci_side, decisive_p, non_inferior
@@ -564,6 +565,10 @@ def confirm_evidence(
     pi = prob_improvement(wide[c.a.name].to_numpy(), wide[c.b.name].to_numpy())
     ra, rb = summary.loc[(c.model, c.a.name)], summary.loc[(c.model, c.b.name)]
     family, against = c.labels
+    label_a = c.a.label()
+    if c.a.family == "dpw":  # named by its measured plan depth (rsmhp.report.naming)
+        depth, rollout = float(ra["plan_depth"]), c.a.method.rollout
+        family, label_a = (depth_name(x, depth, rollout) for x in (family, label_a))
     members = comparator_members(c, runs, summary, verdict)
     # a superiority rule's equivalence margin; a non-inferiority rule's margin is the null
     key = KeyNumber(WORDS("confirm_key", family=family, against=against), float(d.mean),
@@ -579,7 +584,7 @@ def confirm_evidence(
         "test": c.spec["test"],
         "margin": param_text(c.margin),
         "why": str(c.spec.get("why", "")),
-        "a": c.a.label(),
+        "a": label_a,
         "b": c.b.label(),
         "runs": d.n,
         "error_a": fmt(float(ra["mean_error"])),

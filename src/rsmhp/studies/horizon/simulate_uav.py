@@ -90,7 +90,10 @@ APPROX_COLUMNS = [
 HORIZON_REGRET_COLUMNS = ["H", *REGRET_COLUMNS, "plan_ms"]
 
 #: one closed-loop run of one method with planning horizon H
-CLOSED_COLUMNS = ["model", "H", "method", "family", "run", "mean_error", "final_error", "plan_ms"]
+#: ``plan_depth``: a tree search's mean plan depth over the run's steps (empty for the others)
+CLOSED_COLUMNS = [
+    "model", "H", "method", "family", "run", "mean_error", "final_error", "plan_ms", "plan_depth",
+]  # fmt: skip
 
 
 def horizon_setup(uav: Mapping[str, Any], model: Mapping[str, Any], H: int) -> UAVSetup:
@@ -295,6 +298,7 @@ def closed_contract(cfg: Mapping[str, Any], model: str, H: int) -> Contract:
         columns=CLOSED_COLUMNS,
         text=("model", "method", "family"),
         integer=("H", "run"),
+        nullable=("plan_depth",),
         keys=("method", "run"),
         expected=pd.DataFrame(keys, columns=["method", "run"]),
         values={"model": model, "H": int(H)},
@@ -334,6 +338,7 @@ def run_horizon_closed(
             "mean_error": summary["mean_error"],
             "final_error": summary["final_error"],
             "plan_ms": 1e3 * summary["plan_seconds"] / setup.steps,
+            "plan_depth": summary.get("diagnostics", {}).get("plan_depth", float("nan")),
         }
         for (_, m, _, r), (summary, _) in zip(jobs, summaries, strict=True)
     ]

@@ -46,6 +46,7 @@ import pandas as pd
 from rsmhp.core.stats import mean_ci
 from rsmhp.models.uav import methods
 from rsmhp.pipeline.protocol import tuned_configurations
+from rsmhp.report.naming import depth_name
 
 __all__ = [
     "BEST_COLUMNS",
@@ -81,15 +82,19 @@ GROUPS: dict[str, tuple[str, str]] = {
 #: ``value``): ``model`` the grid's row (model variant; footprint in the ``scenario`` group),
 #: ``value`` its column (budget in ms, H or q); ``method`` is unique in its cell (a
 #: configuration name in the ``budget`` group), ``member`` the registered method behind it (its
-#: label and colour), ``family`` its family
-BEST_RUN_COLUMNS = ["group", "model", "value", "method", "member", "family", "run", "error"]
+#: label and colour), ``family`` its family, ``plan_depth`` a tree search's mean plan depth
+#: over the run's steps (empty for the other methods, and optional)
+BEST_RUN_COLUMNS = [
+    "group", "model", "value", "method", "member", "family", "run", "error", "plan_depth",
+]  # fmt: skip
 #: the columns :func:`best_family` cannot do without (``member`` defaults to ``method``,
 #: ``family`` to ``method``)
 REQUIRED = ["group", "model", "value", "method", "run", "error"]
 #: one row per cell (:func:`best_family`); ``tied`` the tied methods joined by ``;``
 BEST_COLUMNS = [
     "group", "model", "value", "runs", "methods", "best", "best_member", "best_label",
-    "best_family", "best_mean", "runner_up", "runner_up_member", "runner_up_mean", "runner_up_diff",
+    "best_family", "best_depth", "best_mean", "runner_up", "runner_up_member", "runner_up_mean",
+    "runner_up_diff",
     "runner_up_low", "runner_up_high", "tied", "n_tied", "clear",
 ]  # fmt: skip
 #: one row per (cell, method other than the best): the paired difference method − best
@@ -128,6 +133,9 @@ def _check(runs: pd.DataFrame) -> pd.DataFrame:
     for col in ("member", "family"):
         if col not in r.columns:
             r[col] = r["method"]
+    if "plan_depth" not in r.columns:
+        r["plan_depth"] = np.nan
+    r["plan_depth"] = pd.to_numeric(r["plan_depth"], errors="coerce").astype(float)
     for col in ("group", "model", "value", "method", "run"):
         n = int(r[col].isna().sum())
         if n:
@@ -216,12 +224,15 @@ def best_family(runs: pd.DataFrame, level: float = 0.95) -> Best:
                            "mean_diff": d, "low": low, "high": high, "tied": is_tied})  # fmt: skip
         paired.extend(rows)
         second = rows[0]  # the runner-up: the next lowest mean
+        member = first.loc[best, "member"]
+        depths = cell.loc[cell["method"] == best, "plan_depth"]
+        depth = float(depths.mean()) if depths.notna().all() and len(depths) else np.nan
         cells.append({
             "group": group, "model": model, "value": value, "runs": int(wide.shape[0]),
             "methods": int(wide.shape[1]), "best": best,
             "best_member": first.loc[best, "member"],
-            "best_label": short_label(first.loc[best, "member"]),
-            "best_family": first.loc[best, "family"],
+            "best_label": depth_name(short_label(member), depth, _rollout(member), short=True),
+            "best_family": first.loc[best, "family"], "best_depth": depth,
             "best_mean": float(means[best]), "runner_up": second["method"],
             "runner_up_member": second["member"], "runner_up_mean": second["mean"],
             "runner_up_diff": second["mean_diff"], "runner_up_low": second["low"],
@@ -230,6 +241,15 @@ def best_family(runs: pd.DataFrame, level: float = 0.95) -> Best:
         })  # fmt: skip
     return Best(pd.DataFrame(cells, columns=BEST_COLUMNS),
                 pd.DataFrame(paired, columns=PAIRED_COLUMNS))  # fmt: skip
+
+
+def _rollout(member: str) -> str:
+    """The rollout policy of a tree-search member (``pursuit`` for any other method: only a
+    tree search has a measured plan depth to name it by)."""
+    try:
+        return str(getattr(methods.from_name(str(member)), "rollout", "pursuit"))
+    except ValueError:
+        return "pursuit"
 
 
 def short_label(member: str) -> str:
@@ -252,15 +272,17 @@ def _family(member: str) -> str:
     return methods.from_name(member).family
 
 
-def _long(group: str, model, value, method, member, run, error) -> pd.DataFrame:
+def _long(group: str, model, value, method, member, run, error, depth=None) -> pd.DataFrame:
     member = pd.Series(member, dtype=object).reset_index(drop=True)
+    n = len(member)
+    depth = np.full(n, np.nan) if depth is None else pd.Series(depth, dtype=float).to_numpy()
     return pd.DataFrame({
         "group": group, "model": pd.Series(model, dtype=object).reset_index(drop=True),
         "value": pd.Series(value, dtype=float).reset_index(drop=True),
         "method": pd.Series(method, dtype=object).reset_index(drop=True), "member": member,
         "family": member.map(_family),
         "run": pd.Series(run).astype(int).reset_index(drop=True),
-        "error": pd.Series(error, dtype=float).reset_index(drop=True),
+        "error": pd.Series(error, dtype=float).reset_index(drop=True), "plan_depth": depth,
     }, columns=BEST_RUN_COLUMNS)  # fmt: skip
 
 
@@ -303,7 +325,8 @@ def budget_runs(
                     )
                 c = g[g["config"] == name]
                 parts.append(_long(BUDGET, c["model"], np.full(len(c), float(b)), c["config"],
-                                   c["member"], c["run"], c["mean_error"]))  # fmt: skip
+                                   c["member"], c["run"], c["mean_error"],
+                                   c.get("plan_depth")))  # fmt: skip
     return _sorted(pd.concat(parts, ignore_index=True)) if parts else _empty()
 
 
@@ -311,7 +334,8 @@ def horizon_runs(closed: pd.DataFrame) -> pd.DataFrame:
     """The ``horizon`` group (:data:`BEST_RUN_COLUMNS`) of the long-horizon closed loop
     (columns ``model``, ``H``, ``method``, ``run``, ``mean_error``): one cell per (model, H)."""
     c = closed
-    out = _long(HORIZON, c["model"], c["H"], c["method"], c["method"], c["run"], c["mean_error"])
+    out = _long(HORIZON, c["model"], c["H"], c["method"], c["method"], c["run"], c["mean_error"],
+                c.get("plan_depth"))  # fmt: skip
     return _sorted(out)
 
 
@@ -328,7 +352,7 @@ def scenario_runs(map_runs: pd.DataFrame) -> pd.DataFrame:
     m = map_runs
     rows = [footprint_label(v) for v in m["row_value"]]
     out = _long(SCENARIO, rows, m["col_value"], m["method"], m["method"], m["run"],
-                m["mean_error"])  # fmt: skip
+                m["mean_error"], m.get("plan_depth"))  # fmt: skip
     return _sorted(out)
 
 

@@ -17,6 +17,7 @@ import pandas as pd
 from rsmhp.models.uav import methods
 from rsmhp.report.ledger import Section
 from rsmhp.report.markdown import ci_cells, fmt, markdown_table, param_text
+from rsmhp.report.naming import depth_name
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import render
 from rsmhp.studies.scenarios import TABLES
@@ -54,6 +55,11 @@ def config_label(method: str, member: str) -> str:
     return label
 
 
+def _rollout(member: str) -> str:
+    """A tree-search member's rollout policy (``pursuit`` for any other method)."""
+    return str(getattr(methods.from_name(str(member)), "rollout", "pursuit"))
+
+
 def _axis_text(group: str, value: float) -> str:
     text = param_text(value)
     return {BUDGET: f"{text} ms", HORIZON: f"H = {text}", SCENARIO: f"q = {text}"}.get(group, text)
@@ -79,8 +85,8 @@ def best_table(best: pd.DataFrame, paired: pd.DataFrame) -> str:
             "column": [_axis_text(g, a) for g, a in zip(best["group"], best["value"], strict=True)],
             "runs": best["runs"].astype(int),
             "methods": best["methods"].astype(int),
-            "best": [config_label(m, b) for m, b in
-                     zip(best["best"], best["best_member"], strict=True)],
+            "best": [depth_name(config_label(m, b), d, _rollout(b)) for m, b, d in
+                     zip(best["best"], best["best_member"], best["best_depth"], strict=True)],
             "its mean error (m)": best["best_mean"],
             "runner-up": [config_label(m, b) for m, b in
                           zip(best["runner_up"], best["runner_up_member"], strict=True)],
@@ -108,6 +114,8 @@ def scenarios_tables(
             "P(beats NBO)": summary["p_improve"],
             "95% CI": ci_cells(summary["low"], summary["high"]),
             "share of scenarios > 1/2": summary["share_above_half"],
+            "mean error − NBO's (m)": summary["mean_diff"],
+            "scenarios worse on average": summary["worse_scenarios"].astype(int),
         }
     )
     p = pd.DataFrame(
@@ -121,49 +129,51 @@ def scenarios_tables(
     )
     return {
         "scenarios_best": best_table(best, paired),
-        "scenarios_improvement": markdown_table(t, digits=3),
+        "scenarios_improvement": markdown_table(t, digits=3, signed=("mean error − NBO's (m)",)),
         "scenarios_per_scenario": markdown_table(p, digits=3, signed=("mean error − NBO's (m)",)),
     }
 
 
 @dataclass(frozen=True)
 class Estimate:
-    """One method's probability of beating NBO on a group, formatted: ``p`` in ``[low, high]``."""
+    """One method on a group of scenarios, formatted: its probability of beating NBO ``p`` in
+    ``[low, high]`` beside its mean paired difference from NBO ``diff`` (m) and the scenarios
+    where it is worse than NBO on average (``worse`` of ``n``)."""
 
     label: str
     p: str
     low: str
     high: str
+    diff: str
+    worse: int
+    n: int
 
 
 @dataclass(frozen=True)
 class GroupText:
-    """What the main text says of a group of scenarios: its size, and its highest and lowest
-    method (``lowest`` is ``None`` when the group has one method)."""
+    """What the main text says of a group of scenarios: its size and every method in the
+    registry's order (``methods``), never ranked by its probability of beating NBO alone."""
 
     group: str
     scenarios: int
-    methods: int
-    highest: Estimate
-    lowest: Estimate | None
+    methods: list[Estimate]
 
 
 def _estimate(r: pd.Series) -> Estimate:
     return Estimate(
-        method_label(r["method"]), fmt(r["p_improve"], 2), fmt(r["low"], 2), fmt(r["high"], 2)
-    )
+        method_label(r["method"]), fmt(r["p_improve"], 2), fmt(r["low"], 2), fmt(r["high"], 2),
+        fmt(r["mean_diff"], 3, True), int(r["worse_scenarios"]), int(r["scenarios"]),
+    )  # fmt: skip
 
 
 def _group_text(summary: pd.DataFrame, group: str) -> GroupText:
-    """The group's highest and lowest method with their intervals (all in the appendix)."""
-    g = summary[summary["group"] == group].sort_values("p_improve", ascending=False)
-    top, low = g.iloc[0], g.iloc[-1]
+    """The group's methods, in the table's (registry) order, each with its probability of
+    beating NBO and its mean difference in metres beside it (all in the appendix)."""
+    g = summary[summary["group"] == group]
     return GroupText(
         group=group,
         scenarios=int(g["scenarios"].max()),
-        methods=len(g),
-        highest=_estimate(top),
-        lowest=_estimate(low) if len(g) > 1 else None,
+        methods=[_estimate(r) for _, r in g.iterrows()],
     )
 
 
