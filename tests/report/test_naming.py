@@ -48,13 +48,14 @@ def test_the_best_method_per_cell_carries_its_mean_depth():
                 "model": "paper",
                 "value": 6,
                 "method": "dpw_s30",
+                "family": "dpw",
                 "run": r,
                 "error": e_t,
                 "plan_depth": d,
             }
         )
         rows.append({"group": "horizon", "model": "paper", "value": 6, "method": "nbo",
-                     "run": r, "error": e_n, "plan_depth": math.nan})  # fmt: skip
+                     "family": "nbo", "run": r, "error": e_n, "plan_depth": math.nan})  # fmt: skip
     cells = best_family(pd.DataFrame(rows)).cells
     (c,) = cells.itertuples(index=False)
     assert c.best == "dpw_s30" and c.best_depth == pytest.approx(1.2)
@@ -70,3 +71,12 @@ def test_the_depth_phrase_is_found_in_a_claims_words():
     words = f"On 'paper', the tuned {depth_name('tree search', 1.2)} member tracks better"
     assert depth_of(words) == "plan depth 1.20: a one-step rollout over the pursuit policy"
     assert depth_of("the tuned RQMC member tracks better") == ""
+
+
+def test_the_pursuit_policy_alone_is_not_named_by_a_depth():
+    # it reports plan depth 0 (no tree): it keeps its name
+    methods = (("pursuit", 1.0, 0.0), ("nbo", 3.0, math.nan))
+    rows = [{"group": "horizon", "model": "paper", "value": 6, "method": m, "family": m,
+             "run": r, "error": e + r, "plan_depth": d}
+            for r in range(3) for m, e, d in methods]  # fmt: skip
+    assert best_family(pd.DataFrame(rows)).cells["best_label"].iloc[0] == "pursuit policy"

@@ -225,8 +225,10 @@ def best_family(runs: pd.DataFrame, level: float = 0.95) -> Best:
         paired.extend(rows)
         second = rows[0]  # the runner-up: the next lowest mean
         member = first.loc[best, "member"]
+        # a tree search's mean plan depth (the pursuit policy alone reports 0: no tree)
         depths = cell.loc[cell["method"] == best, "plan_depth"]
-        depth = float(depths.mean()) if depths.notna().all() and len(depths) else np.nan
+        is_tree = first.loc[best, "family"] == "dpw"
+        depth = float(depths.mean()) if is_tree and depths.notna().all() else np.nan
         cells.append({
             "group": group, "model": model, "value": value, "runs": int(wide.shape[0]),
             "methods": int(wide.shape[1]), "best": best,
