@@ -155,7 +155,27 @@ UAV_SCORING = pick(
 )
 # the confirmatory design: what the committed preregistration and tuned file name (checked
 # here, before any job: a tuned file that is not the preregistered one stops the workflow)
-CONFIRM = _confirm_plan(workflow.basedir, config["frontier"])
+# a dry run's stand-in for a stream a preregistration has not named yet (the placeholder
+# "<named by the run issue>"): allowed in `snakemake -n` only, so no job draws from it
+DRY_RUN = bool(getattr(getattr(workflow, "output_settings", None), "dryrun", False))
+DRY_RUN_STREAM = config.get("dry_run_stream")
+_dry = [
+    k
+    for k, v in (
+        ("dry_run_stream", DRY_RUN_STREAM),
+        ("horizon.stream", config["horizon"]["stream"]),
+    )
+    if v == "dry-run"
+]
+if _dry and not DRY_RUN:
+    sys.exit(
+        f"{', '.join(_dry)}: 'dry-run' is a dry run's stand-in for a stream not yet named; "
+        "it is allowed with snakemake -n only (the run issue names the stream)"
+    )
+try:
+    CONFIRM = _confirm_plan(workflow.basedir, config["frontier"], DRY_RUN_STREAM)
+except ValueError as exc:  # e.g. a preregistration whose stream is not named yet
+    sys.exit(f"invalid confirmatory design (nothing was run): {exc}")
 CONFIRM_MODELS = list(CONFIRM["models"]) if CONFIRM is not None else []
 # the sensitivity map's cells (decisions.map): one job each, wildcard {cell} = r<i>c<j>
 MAP_CELLS = [c.name for c in _map_cells(config["decisions"]["map"])]

@@ -71,6 +71,8 @@ from rsmhp.models.uav.planner import STARTS
 
 __all__ = [
     "CONFIRM_STREAMS",
+    "DRY_RUN_STREAM",
+    "PLACEHOLDER_STREAM",
     "STREAMS",
     "Configuration",
     "Preregistration",
@@ -90,6 +92,13 @@ STREAMS = ("exploratory", "tune", "confirm", "confirm2")
 #: the streams a preregistration may name: ``confirm`` (first confirmatory run) and
 #: ``confirm2`` (the second, after the budget rule changed: a stream its design never saw)
 CONFIRM_STREAMS = ("confirm", "confirm2")
+#: the stream a preregistration holds until the issue that runs it names one: the workflow
+#: refuses to run it (:meth:`Preregistration.load`)
+PLACEHOLDER_STREAM = "<named by the run issue>"
+#: a dry run's stand-in for a stream not yet named (``snakemake -n --config
+#: dry_run_stream=dry-run``): the workflow refuses it outside a dry run, so no job ever draws
+#: from it
+DRY_RUN_STREAM = "dry-run"
 
 
 def stream_seed(seed: int, stream: str) -> int:
@@ -98,7 +107,7 @@ def stream_seed(seed: int, stream: str) -> int:
     ``"<seed>/<stream>"`` (independent of ``seed`` and of each other as far as any test can
     tell)."""
     seed = guards.nonneg_int("seed", seed)
-    if stream not in STREAMS:
+    if stream not in (*STREAMS, DRY_RUN_STREAM):
         raise ValueError(f"stream: {stream!r} (allowed: {', '.join(STREAMS)})")
     if stream == "exploratory":
         return seed
@@ -399,17 +408,58 @@ class Preregistration:
     doc: Mapping[str, Any]
 
     REQUIRED = ("stream", "tuned", "models", "budgets_ms", "headline_budget_ms", "runs", "claims")
+    #: what a version-3 preregistration adds (issue 43): the budget tolerance, each claim's
+    #: comparator rule and secondaries, the power of every claim under its own rule, the
+    #: paper's claims and the scope rule of "the paper's setups"
+    REQUIRED_V3 = ("budget_tolerance", "comparator_rule", "secondaries", "power", "paper_claims",
+                   "scope", "horizon", "holm")  # fmt: skip
 
     @classmethod
-    def load(cls, path: str | Path, tuned_path: str | Path | None = None) -> Preregistration:
-        """Read and check the file: every required key, the stream ``confirm``, budgets and
-        models that the tuned file has, and (given ``tuned_path``) the tuned file's SHA-256
-        equal to the one recorded. Every problem is named; nothing is run."""
+    def load(
+        cls,
+        path: str | Path,
+        tuned_path: str | Path | None = None,
+        dry_run_stream: str | None = None,
+    ) -> Preregistration:
+        """Read and check the file: every required key (and, for ``version: 3``, those of
+        :data:`REQUIRED_V3`), a confirmatory stream, budgets and models that the tuned file has,
+        and (given ``tuned_path``) the tuned file's SHA-256 equal to the one recorded. A
+        stream that is still :data:`PLACEHOLDER_STREAM` is refused unless ``dry_run_stream``
+        is :data:`DRY_RUN_STREAM` (a dry run's stand-in, which the content then holds). Every
+        problem is named; nothing is run."""
         doc = load_yaml(path, "preregistration")
         missing = [k for k in cls.REQUIRED if k not in doc]
+        if doc.get("version", 2) == 3:
+            missing += [k for k in cls.REQUIRED_V3 if k not in doc]
         if missing:
             raise ValueError(f"preregistration {path}: missing {', '.join(missing)}")
-        if doc["stream"] not in CONFIRM_STREAMS:
+        if doc.get("version", 2) == 3:
+            from rsmhp.pipeline.power_design import power_problems
+
+            bad = power_problems(doc["power"])
+            if bad:
+                raise ValueError(f"preregistration {path}: " + "; ".join(bad))
+        if dry_run_stream is not None and dry_run_stream != DRY_RUN_STREAM:
+            raise ValueError(
+                f"dry_run_stream: {dry_run_stream!r} (allowed: {DRY_RUN_STREAM!r}, and only in a "
+                "dry run)"
+            )
+        if doc["stream"] == PLACEHOLDER_STREAM:
+            if dry_run_stream is None:
+                raise ValueError(
+                    f"preregistration {path}: stream is still {PLACEHOLDER_STREAM!r}: the "
+                    "workflow runs no confirmatory job until the issue that runs it names the "
+                    "stream (in a commit of its own); to list the jobs: snakemake -n --config "
+                    f"dry_run_stream={DRY_RUN_STREAM}"
+                )
+            doc = {**doc, "stream": dry_run_stream}
+        elif dry_run_stream is not None:
+            raise ValueError(
+                f"preregistration {path}: dry_run_stream is set but the stream is named "
+                f"({doc['stream']!r}): the stand-in is for a preregistration whose stream is "
+                f"still {PLACEHOLDER_STREAM!r}"
+            )
+        if doc["stream"] not in (*CONFIRM_STREAMS, DRY_RUN_STREAM):
             raise ValueError(
                 f"preregistration {path}: stream {doc['stream']!r} (allowed: "
                 f"{', '.join(map(repr, CONFIRM_STREAMS))}: the verdicts come from a "
@@ -497,7 +547,9 @@ def file_commit(path: str | Path) -> str:
     return commit if commit and not dirty else "uncommitted"
 
 
-def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, Any] | None:
+def confirm_plan(
+    basedir: str | Path, frontier: Mapping[str, Any], dry_run_stream: str | None = None
+) -> dict[str, Any] | None:
     """What the workflow's confirmatory rules need (JSON-ready, the rules' params): the
     preregistration (content, path, sha256; the commit that added it is looked up by the
     rule when it runs, :func:`file_commit`, so that a copy of the workflow outside git does
@@ -505,7 +557,8 @@ def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, 
     per model its runs and configurations; ``None`` when ``frontier`` has no model
     or the preregistration file does not exist (the report then has no FR claims). A
     preregistration that does not fit the tuned file, or names a model outside
-    ``frontier.models``, is refused naming both."""
+    ``frontier.models``, is refused naming both. ``dry_run_stream``: see
+    :meth:`Preregistration.load`."""
     if not frontier.get("models"):
         return None
     conf = frontier["confirm"]
@@ -513,7 +566,7 @@ def confirm_plan(basedir: str | Path, frontier: Mapping[str, Any]) -> dict[str, 
     pre_path, tuned_path = base / conf["preregistration"], base / conf["tuned"]
     if not pre_path.is_file():
         return None
-    pre = Preregistration.load(pre_path, tuned_path)
+    pre = Preregistration.load(pre_path, tuned_path, dry_run_stream)
     tuned = load_yaml(tuned_path, "tuned file")
     outside = [m for m in pre.doc["models"] if m not in frontier["models"]]
     if outside:
