@@ -42,13 +42,16 @@ Sub-packages
                     content-addressed store of computed runs, shared by the rules), parallel
                     (joblib within a thread budget), resources (memory estimates), cluster (SLURM
                     pre-flight), protocol (seed streams, planner configurations, tuning rule,
-                    preregistration), split (jobs split into chunks and merged again), script
-                    (logging and code checks of rule scripts), warm
+                    preregistration), power_design (a preregistration's power, recomputed
+                    under each claim's rule), split (jobs split into chunks and merged
+                    again), script (logging and code checks of rule scripts), warm
                     (compiles every numba kernel once per machine, ``python -m
                     rsmhp.pipeline.warm``)
   report            ledger (KeyNumber, Claim, Section), verdicts (verdict rules as objects),
                     statements (the paper's statements judged on its setups and on variants),
                     findings (the main claims, "What we found"), power (runs at 80% power),
+                    naming (a tree search named by its measured plan depth), disclosures
+                    (choices made after their data, beside the verdicts they touch),
                     history (earlier verdicts, fragility), render (main text, appendix,
                     glance table), html (the HTML report's landing page), templates (Jinja2;
                     Words, a study's claim sentences as macros), claimspec (a claim as
