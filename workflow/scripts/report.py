@@ -85,5 +85,5 @@ with rule_logging(snakemake) as log:
     write_text(
         json.dumps(claims_file, indent=1, ensure_ascii=False) + "\n", snakemake.output.claims
     )
-    write_text(glance_table(claims) + "\n", snakemake.output.glance)
+    write_text(glance_table(claims, history=history) + "\n", snakemake.output.glance)
     log.info("main text %d bytes, %d claims", len(main.encode()), len(records))

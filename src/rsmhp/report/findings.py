@@ -265,12 +265,13 @@ def best_sentence(best: pd.DataFrame | None) -> str:
 
 
 def other_streams(
-    claims: Sequence[Claim], history: pd.DataFrame | None, appendix: str = "appendix.md"
+    claims: Sequence[Claim], history: pd.DataFrame | None, appendix: str | None = "appendix.md"
 ) -> list[dict[str, Any]]:
     """Per earlier seed stream of ``history`` (rows of kind ``stream``, e.g. a superseded
     confirmatory run) that judged some of ``claims``: its label and the claims it judged
-    otherwise ({label, claims: [linked id, its verdict there]}), in the history's order. The
-    main text says so next to the claims, not only in the fragility list."""
+    otherwise ({label, claims: [linked id (the bare id when ``appendix`` is ``None``), its
+    verdict there]}), in the history's order. The main text says so next to the claims, not
+    only in the fragility list."""
     if history is None or history.empty:
         return []
     by_id = {c.id: c for c in claims}
@@ -278,7 +279,7 @@ def other_streams(
     out = []
     for label, g in rows.groupby("label", sort=False):
         other = [
-            (link(r.claim, appendix), r.verdict)
+            (link(r.claim, appendix) if appendix is not None else str(r.claim), r.verdict)
             for r in g.itertuples(index=False)
             if r.verdict != by_id[r.claim].verdict
         ]

@@ -24,8 +24,16 @@ from typing import Any
 import pandas as pd
 import yaml
 
-from rsmhp.report.disclosures import disclosure_lines
-from rsmhp.report.findings import MAIN_CLAIMS, found_values, key_text, link, main_rows, verdict_text
+from rsmhp.report.disclosures import disclosure_lines, verdict_note
+from rsmhp.report.findings import (
+    MAIN_CLAIMS,
+    found_values,
+    key_text,
+    link,
+    main_rows,
+    other_streams,
+    verdict_text,
+)
 from rsmhp.report.history import fragility
 from rsmhp.report.ledger import STATEMENT_VERDICTS, VERDICTS, Claim, Section
 from rsmhp.report.markdown import escape
@@ -129,19 +137,31 @@ def statements_records(judgements: Iterable[Judgement]) -> list[dict[str, Any]]:
     ]
 
 
-def glance_table(claims: Iterable[Claim], statements: Sequence[Statement] | None = None) -> str:
+def glance_table(
+    claims: Iterable[Claim],
+    statements: Sequence[Statement] | None = None,
+    history: pd.DataFrame | None = None,
+) -> str:
     """The README's "results at a glance": the paper's statements (default
     :data:`rsmhp.report.statements.STATEMENTS`) with their verdicts on the paper's setups and on
-    variants, then the benchmark's own main claims (:data:`rsmhp.report.findings.MAIN_CLAIMS`
-    without a statement), their verdicts per setup."""
+    variants (each piece with the note of a choice made after its data,
+    :func:`rsmhp.report.disclosures.verdict_note`), then the benchmark's own main claims
+    (:data:`rsmhp.report.findings.MAIN_CLAIMS` without a statement), their verdicts per
+    setup with their contrary evidence, and the verdicts an earlier seed stream of
+    ``history`` gave them otherwise (:func:`rsmhp.report.findings.other_streams`)."""
     claims = list(claims)
     by_id = {c.id: c for c in claims}
     judgements, _ = judge_all(claims, statements)
+
+    def piece(c: Claim) -> str:
+        note = verdict_note(c)
+        return f"{c.id} {c.verdict}" + (f" ({note})" if note else "")
+
     lines = [WORDS("statements_header"), "|---|---|---|---|"]
     for j in judgements:
-        pieces = ", ".join(f"{c.id} {c.verdict}" for c in j.counted)
+        pieces = ", ".join(piece(c) for c in j.counted)
         var = (
-            f"{j.on_variants} ({', '.join(f'{c.id} {c.verdict}' for c in j.alongside)})"
+            f"{j.on_variants} ({', '.join(piece(c) for c in j.alongside)})"
             if j.on_variants
             else "–"
         )
@@ -155,10 +175,15 @@ def glance_table(claims: Iterable[Claim], statements: Sequence[Statement] | None
         for m in ours:
             per = "; ".join(
                 f"{lab}: {verdict_text(by_id[i])} ({escape(key_text(by_id[i]))})"
+                + (f"; contrary: {escape(by_id[i].contrary)}" if by_id[i].contrary else "")
                 for lab, i in m.setups
                 if i in by_id
             )
             lines.append(f"| {m.name} | {escape(m.says)} | {per} |")
+        mine = [by_id[i] for m in ours for _, i in m.setups if i in by_id]
+        for st in other_streams(mine, history, appendix=None):
+            others = ", ".join(f"{cid} {v}" for cid, v in st["claims"])
+            lines += ["", WORDS("glance_streams", label=st["label"], n=st["n"], others=others)]
     return "\n".join(lines)
 
 
