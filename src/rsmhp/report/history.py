@@ -29,7 +29,7 @@ from pathlib import Path
 
 import pandas as pd
 
-from rsmhp.report.ledger import VERDICTS, Claim
+from rsmhp.report.ledger import CLAIM_OUTCOMES, Claim
 from rsmhp.report.markdown import fmt
 
 __all__ = ["COLUMNS", "KINDS", "add_claims", "fragility", "load_history", "main"]
@@ -63,8 +63,10 @@ def load_history(path: str | os.PathLike | None) -> pd.DataFrame:
             )
         for col in ("verdict", "against"):
             v = row[col]
-            if isinstance(v, str) and v not in VERDICTS:
-                raise ValueError(f"{path} row {i + 2}: {col} must be one of {VERDICTS}, got {v!r}")
+            if isinstance(v, str) and v not in CLAIM_OUTCOMES:
+                raise ValueError(
+                    f"{path} row {i + 2}: {col} must be one of {CLAIM_OUTCOMES}, got {v!r}"
+                )
         if not isinstance(row["verdict"], str):
             raise ValueError(f"{path} row {i + 2}: verdict is missing")
     df["against"] = df["against"].where(df["against"].notna(), None)

@@ -18,6 +18,8 @@ from typing import Any
 from rsmhp.report.markdown import fmt, fmt_ci
 
 __all__ = [
+    "CLAIM_OUTCOMES",
+    "OVER_BUDGET",
     "PARTS",
     "REPRODUCIBILITY",
     "STATEMENT_VERDICTS",
@@ -32,6 +34,12 @@ __all__ = [
 #: opposite side (``not supported``), inside the claim's equivalence margin ±m so that any
 #: difference is smaller than m (``equivalent``), or none of these (``inconclusive``)
 VERDICTS = ("supported", "not supported", "equivalent", "inconclusive")
+
+#: what a preregistered claim gets instead of a verdict when a compared member spent more than
+#: the budget allows on the confirmatory run (its rule says by how much): no verdict at all
+OVER_BUDGET = "over budget"
+#: every outcome a claim can have: a verdict, or :data:`OVER_BUDGET`
+CLAIM_OUTCOMES = (*VERDICTS, OVER_BUDGET)
 
 #: verdicts of a paper statement with several pieces of evidence: a claim verdict, ``mixed``
 #: when its pieces of evidence disagree, ``not tested`` on a kind of setup without evidence
@@ -144,8 +152,8 @@ class Claim:
     check: bool = False
 
     def __post_init__(self) -> None:
-        if self.verdict not in VERDICTS:
-            raise ValueError(f"verdict must be one of {VERDICTS}, got {self.verdict!r}")
+        if self.verdict not in CLAIM_OUTCOMES:
+            raise ValueError(f"verdict must be one of {CLAIM_OUTCOMES}, got {self.verdict!r}")
         if not self.rule.strip():
             raise ValueError(f"claim {self.id}: the verdict rule is missing")
         if self.part not in PARTS:

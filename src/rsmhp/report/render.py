@@ -35,7 +35,7 @@ from rsmhp.report.findings import (
     verdict_text,
 )
 from rsmhp.report.history import fragility
-from rsmhp.report.ledger import STATEMENT_VERDICTS, VERDICTS, Claim, Section
+from rsmhp.report.ledger import CLAIM_OUTCOMES, STATEMENT_VERDICTS, VERDICTS, Claim, Section
 from rsmhp.report.markdown import escape
 from rsmhp.report.power import runs_text
 from rsmhp.report.statements import GENERAL_RULE, HEDGED_RULE, Judgement, Statement, judge_all
@@ -358,12 +358,12 @@ def render_appendix(
         mixed=[j for j in judgements if j.disagreeing],
         notes=[j.statement for j in judgements if j.statement.note],
         paper=paper,
-        paper_counts=_counts((c.verdict for c in paper), VERDICTS),
+        paper_counts=_counts((c.verdict for c in paper), CLAIM_OUTCOMES),
         beyond=beyond,
-        beyond_counts=_counts((c.verdict for c in beyond), VERDICTS),
+        beyond_counts=_counts((c.verdict for c in beyond), CLAIM_OUTCOMES),
         findings_table=claims_table(paper + beyond),
         checks=checks,
-        checks_counts=_counts((c.verdict for c in checks), VERDICTS),
+        checks_counts=_counts((c.verdict for c in checks), CLAIM_OUTCOMES),
         checks_table=claims_table(checks),
         fragile=[(c, d["fragile"]) for c, d in zip(claims, details, strict=True) if d["fragile"]],
         details=details,

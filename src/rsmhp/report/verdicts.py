@@ -28,7 +28,7 @@ import numpy as np
 import scipy  # scipy.stats loads on first use (scipy's lazy submodules)
 
 from rsmhp.core.stats import ExceedanceTest, holm
-from rsmhp.report.ledger import STATEMENT_VERDICTS, Claim, Section
+from rsmhp.report.ledger import OVER_BUDGET, STATEMENT_VERDICTS, Claim, Section
 
 __all__ = [
     "HOLM_FAMILY",
@@ -55,9 +55,10 @@ class Case:
     test: Callable[[Facts], bool]
 
     def __post_init__(self) -> None:
-        if self.verdict not in STATEMENT_VERDICTS:
+        if self.verdict not in (*STATEMENT_VERDICTS, OVER_BUDGET):
             raise ValueError(
-                f"Case.verdict must be one of {STATEMENT_VERDICTS}, got {self.verdict!r}"
+                f"Case.verdict must be one of {(*STATEMENT_VERDICTS, OVER_BUDGET)}, "
+                f"got {self.verdict!r}"
             )
         if not self.when.strip():
             raise ValueError("Case.when must say the condition in words, got ''")

@@ -47,12 +47,12 @@ from rsmhp.models.uav.methods.rqmc import RQMC
 from rsmhp.models.uav.methods.sigma_points import SigmaPoints
 from rsmhp.models.uav.methods.tree_search import TreeSearch
 from rsmhp.report.claimspec import ClaimSpec, Evidence
-from rsmhp.report.ledger import Claim, KeyNumber
+from rsmhp.report.ledger import OVER_BUDGET, Claim, KeyNumber
 from rsmhp.report.markdown import fmt, fmt_ci, param_text
 from rsmhp.report.naming import depth_name
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import Words
-from rsmhp.report.verdicts import Rule, ci_side, decisive_p, non_inferior
+from rsmhp.report.verdicts import Case, Rule, ci_side, decisive_p, non_inferior
 from rsmhp.studies.frontier.summarise import (
     Paired,
     budget_check,
@@ -430,6 +430,24 @@ class Comparison:
     b: Configuration
     labels: tuple[str, str]
     sha: str
+    #: the preregistration's ``secondaries`` (version 3) and the model's tuned configurations
+    #: (budget text -> family -> Configuration) they are read from; ``None``: none
+    #: preregistered (the claim then shows every other comparator member, post hoc)
+    secondaries: Mapping[str, Any] | None = None
+    chosen: Mapping[str, Mapping[str, Configuration]] | None = None
+    #: the preregistration's ``budget_tolerance`` (version 3): a compared member whose mean
+    #: closed-loop time per step exceeds (1 + tolerance) x the budget makes the claim
+    #: ``over budget`` (no verdict); ``None``: no such rule
+    tolerance: float | None = None
+
+    def over_budget(self, summary: pd.DataFrame) -> bool:
+        """Whether a compared member spent more than the tolerance allows (``summary``
+        indexed by model and config, ``loop_ms`` the closed loop's mean time per step)."""
+        if self.tolerance is None:
+            return False
+        limit = self.budget_ms * (1.0 + float(self.tolerance))
+        return any(float(summary.loc[(self.model, x.name), "loop_ms"]) > limit
+                   for x in (self.a, self.b))  # fmt: skip
 
     @property
     def superiority(self) -> bool:
@@ -443,7 +461,13 @@ class Comparison:
         """:func:`confirm_rule` with the preregistration's note."""
         r = confirm_rule(self.spec["test"], *self.labels, self.budget_ms, self.margin)
         note = WORDS("confirm_note", sha=self.sha[:12])
-        return PreregisteredRule(cases=r.cases, otherwise=r.otherwise, basis=r.basis, note=note)
+        cases = r.cases
+        if self.tolerance is not None:
+            limit = param_text(self.budget_ms * (1.0 + float(self.tolerance)))
+            when = WORDS("over_budget_when", limit=limit, tolerance=f"{float(self.tolerance):.0%}")
+            over = Case(OVER_BUDGET, when, lambda f: f.get("over_budget", 0.0) > 0)
+            cases = (over, *cases)
+        return PreregisteredRule(cases=cases, otherwise=r.otherwise, basis=r.basis, note=note)
 
 
 def _over_budget(c: Comparison, summary: pd.DataFrame) -> list[dict[str, Any]]:
@@ -501,7 +525,10 @@ def _configuration(row: Any) -> Configuration:
     from rsmhp.pipeline.protocol import Configuration
 
     maxiter = None if pd.isna(row.maxiter) else int(row.maxiter)
-    return Configuration(str(row.member), maxiter, int(row.restarts))
+    start = "pursuit" if str(row.config).endswith("/pursuit") else "warm"
+    if not Configuration(str(row.member)).method.estimates_cost:
+        return Configuration(str(row.member))
+    return Configuration(str(row.member), maxiter, int(row.restarts), start)
 
 
 def comparator_members(
@@ -537,6 +564,49 @@ def comparator_members(
     return sorted(out, key=lambda m: m["loop_ms"])
 
 
+def preregistered_secondaries(
+    c: Comparison, runs: pd.DataFrame, summary: pd.DataFrame, verdict: str
+) -> list[dict[str, Any]]:
+    """The claim's preregistered secondary results (``c.secondaries``, version 3): its member
+    against the comparator family's tuned member at every budget of
+    ``against_comparator_budgets_ms`` (but the claim's own comparator) and against the tuned
+    member of every family of ``against_families`` at the headline budget (but the claim's
+    own family); per comparison what :func:`comparator_members` gives. A budget or family
+    without a tuned member is left out; a tuned member without confirmatory runs is refused,
+    naming it."""
+    if not c.secondaries or c.chosen is None:
+        return []
+    targets: list[Configuration] = []
+    for b in c.secondaries.get("against_comparator_budgets_ms", []):
+        cfg = c.chosen.get(f"{float(b):g}", {}).get(c.b.family)
+        if cfg is not None and cfg != c.b and cfg not in targets:
+            targets.append(cfg)
+    head = c.chosen.get(f"{c.budget_ms:g}", {})
+    for fam in c.secondaries.get("against_families", []):
+        cfg = head.get(fam)
+        if cfg is not None and fam != c.a.family and cfg not in targets:
+            targets.append(cfg)
+    have = set(runs.loc[runs["model"] == c.model, "config"])
+    bound = 0.0 if c.superiority else c.margin
+    out = []
+    for cfg in targets:
+        if cfg.name not in have:
+            raise ValueError(
+                f"{c.cid} on {c.model!r}: the preregistered secondary {cfg.name!r} has no "
+                "confirmatory runs"
+            )
+        d = paired_configs(runs, c.model, c.a.name, cfg.name)
+        loop = float(summary.loc[(c.model, cfg.name), "loop_ms"])
+        out.append({
+            "label": cfg.label(), "loop": fmt(loop, 3), "over": loop > c.budget_ms,
+            "better": float(d.mean) < 0, "diff": fmt(float(d.mean), 3, True),
+            "ci": fmt_ci(float(d.low), float(d.high), 3, True),
+            "opposite": _against_verdict(verdict, d.low, d.high, c.margin, bound),
+            "loop_ms": loop,
+        })  # fmt: skip
+    return out
+
+
 def _depth(row: pd.Series) -> dict[str, str]:
     """The tree search's depths: how far its plans follow its tree (``fr_confirm_measured``)."""
     return {
@@ -556,8 +626,12 @@ def confirm_evidence(
     evidence of the budget and of the ladder ``lad``."""
     d = paired_configs(runs, c.model, c.a.name, c.b.name)
     rule = c.rule()
-    verdict = rule.verdict(paired_facts(d))
-    if c.superiority:
+    over = c.over_budget(summary)
+    facts = {**paired_facts(d), "over_budget": float(over)}
+    verdict = rule.verdict(facts)
+    if over:  # no verdict: no p-value either, so it stays out of Holm's family
+        p = None
+    elif c.superiority:
         p = _p_side(d, verdict, c.margin)
     else:
         p = _p_noninferior(d, verdict, c.margin)
@@ -569,7 +643,10 @@ def confirm_evidence(
     if c.a.family == "dpw":  # named by its measured plan depth (rsmhp.report.naming)
         depth, rollout = float(ra["plan_depth"]), c.a.method.rollout
         family, label_a = (depth_name(x, depth, rollout) for x in (family, label_a))
-    members = comparator_members(c, runs, summary, verdict)
+    prereg = bool(c.secondaries)
+    members = (preregistered_secondaries if prereg else comparator_members)(
+        c, runs, summary, verdict
+    )
     # a superiority rule's equivalence margin; a non-inferiority rule's margin is the null
     key = KeyNumber(WORDS("confirm_key", family=family, against=against), float(d.mean),
                     float(d.low), float(d.high), unit="m", reproducible="statistical", digits=3,
@@ -599,11 +676,16 @@ def confirm_evidence(
         "loop_b": fmt(float(rb["loop_ms"]), 3),
         "depth": _depth(ra) if c.a.family == "dpw" else None,
         "members": members,
+        "prereg": prereg,
         "contrary": _over_budget(c, summary)
         + _ladder_against(c, lad, verdict)
-        + [{"kind": "member", "against": against, **m} for m in members if m["opposite"]],
+        + [
+            {"kind": "member", "against": against, "prereg": prereg, **m}
+            for m in members
+            if m["opposite"]
+        ],
     }
-    return Evidence(key=key, facts=paired_facts(d), values=values, rule=rule)
+    return Evidence(key=key, facts=facts, values=values, rule=rule)
 
 
 FR_CONFIRM = ClaimSpec(
@@ -643,6 +725,8 @@ def confirm_claims(
             fam, ref = spec["family"], spec["against"]
             if fam in per and ref in per:
                 pair = (labels.get(fam, fam), labels.get(ref, ref))
-                c = Comparison(cid, model, spec, b, per[fam], per[ref], pair, prereg_sha)
+                c = Comparison(cid, model, spec, b, per[fam], per[ref], pair, prereg_sha,
+                               prereg.get("secondaries"), chosen.get(model, {}),
+                               prereg.get("budget_tolerance"))  # fmt: skip
                 out.append(FR_CONFIRM.build(c, runs, s, lad))
     return out
