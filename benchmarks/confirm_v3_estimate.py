@@ -4,6 +4,7 @@ place of the published one, from a finished run's own job times (issue 43).
     .venv/bin/python benchmarks/confirm_v3_estimate.py [--results results]
         [--preregistration config/preregistration_v3.yaml] [--tuned config/tuned_v3.yaml]
         [--candidates paper/tuning_v3/candidates.csv] [--avx2 1.06] [--setup 90]
+        [--job-seconds paper/tuning_v3/replication_job_seconds.csv] [--write-job-seconds FILE]
 
 Every job's wall time is the ``s`` column of its ``results/benchmarks/`` file. What the design
 changes is scaled: the UAV study's simulations by the ratio of closed-loop runs, the decision
@@ -16,6 +17,9 @@ kernels) is added as measured by the fresh-clone runs (about 90 s). ``--avx2`` s
 time to a CPU without AVX-512 (1.06: the emulated run of issue 35, docs/performance.md). The
 wall time on two cores is at least half the job time (no idle core), so the estimate prints
 that bound: a lower bound of the wall time, not a forecast. Nothing is run.
+``--job-seconds`` reads the per-rule sums from a CSV (rule, seconds) instead of
+``results/benchmarks/`` (the committed one is the replication the third preregistration's
+estimate used); ``--write-job-seconds`` writes that CSV from ``results/``.
 """
 
 from __future__ import annotations
@@ -54,8 +58,18 @@ def main() -> None:
     ap.add_argument("--config", default="config/config.yaml")
     ap.add_argument("--avx2", type=float, default=1.06)
     ap.add_argument("--setup", type=float, default=90.0)
+    ap.add_argument("--job-seconds", default=None)
+    ap.add_argument("--write-job-seconds", default=None)
     a = ap.parse_args()
-    jobs = job_seconds(Path(a.results))
+    if a.job_seconds:
+        table = pd.read_csv(a.job_seconds)
+        jobs = dict(zip(table["rule"], table["seconds"].astype(float), strict=True))
+    else:
+        jobs = job_seconds(Path(a.results))
+    if a.write_job_seconds:
+        pd.DataFrame(sorted(jobs.items()), columns=["rule", "seconds"]).to_csv(
+            a.write_job_seconds, index=False, float_format="%.2f"
+        )
     cfg = yaml.safe_load(Path(a.config).read_text())
     pre = Preregistration.load(a.preregistration, a.tuned, DRY_RUN_STREAM)
     tuned = yaml.safe_load(Path(a.tuned).read_text())

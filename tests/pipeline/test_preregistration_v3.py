@@ -125,7 +125,27 @@ def test_a_dry_run_lists_the_jobs_and_a_real_run_is_refused(tmp_path):
     assert "frontier_confirm " in out and "horizon_uav " in out
     real = _snakemake(tmp_path, "-j1", "--config", "dry_run_stream=dry-run")
     assert real.returncode != 0
-    assert "allowed with snakemake -n only" in real.stdout + real.stderr
+    said = real.stdout + real.stderr
+    assert "allowed with snakemake -n only" in said
+    for key in ("horizon.stream", "uav.stream", "decisions.stream"):  # every study's stream
+        assert key in said, key
     plain = _snakemake(tmp_path, "-n")  # no stand-in: the placeholder refuses
     assert plain.returncode != 0 and "stream is still" in plain.stdout + plain.stderr
     assert not (tmp_path / "results").exists()
+
+
+def test_the_fr_sds_are_those_of_the_committed_tuning_runs():
+    """The FR claims' sds come from the tuning runs (paper/tuning_v3/runs_<model>.csv): the
+    sd of the paired difference of the two tuned members the entry names."""
+    import pandas as pd
+
+    doc = _doc()
+    for cid in doc["claims"]:
+        for model, e in doc["power"][cid].items():
+            src = e["sd_from"]
+            assert src["stream"] == "tune"
+            runs = pd.read_csv(ROOT / "paper" / "tuning_v3" / f"runs_{model}.csv")
+            w = runs.pivot(index="run", columns="config", values="mean_error")
+            assert len(w) == src["runs"]
+            sd = float((w[src["a"]] - w[src["b"]]).std(ddof=1))
+            assert sd == pytest.approx(e["sd"], abs=6e-4), (cid, model)

@@ -13,7 +13,11 @@ def test_below_a_depth_of_two_it_is_a_one_step_rollout():
     assert depth_name("tree search 30 sims", 1.2) == (
         "tree search 30 sims (plan depth 1.20: a one-step rollout over the pursuit policy)"
     )
-    assert depth_name("tree search", 1.999, rollout="warm").endswith("over the warm start)")
+    assert depth_name("tree search", 1.99, rollout="warm") == (
+        "tree search (plan depth 1.99: a one-step rollout over the warm start)"
+    )
+    # decided on the depth as printed: 1.999 reads 2.00 and is no rollout
+    assert depth_name("tree search", 1.999) == "tree search (plan depth 2.00)"
     assert (
         depth_name("tree search 100 sims", ROLLOUT_DEPTH)
         == "tree search 100 sims (plan depth 2.00)"

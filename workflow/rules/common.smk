@@ -3,6 +3,7 @@ from rsmhp.models.uav import methods as _registry
 from rsmhp.pipeline.code_digest import code_digest as _code_digest
 from rsmhp.pipeline.code_digest import method_only
 from rsmhp.pipeline.protocol import confirm_plan as _confirm_plan
+from rsmhp.pipeline.protocol import stream_seed as _stream_seed
 from rsmhp.models.uav.scoring import map_cells as _map_cells
 from rsmhp.models.uav.simulation import MODEL_KEYS as _UAV_MODEL_KEYS
 
@@ -164,6 +165,8 @@ _dry = [
     for k, v in (
         ("dry_run_stream", DRY_RUN_STREAM),
         ("horizon.stream", config["horizon"]["stream"]),
+        ("uav.stream", config["uav"].get("stream")),
+        ("decisions.stream", config["decisions"].get("stream")),
     )
     if v == "dry-run"
 ]
@@ -176,7 +179,18 @@ try:
     CONFIRM = _confirm_plan(workflow.basedir, config["frontier"], DRY_RUN_STREAM)
 except ValueError as exc:  # e.g. a preregistration whose stream is not named yet
     sys.exit(f"invalid confirmatory design (nothing was run): {exc}")
+if CONFIRM is not None and CONFIRM["stream"] == "dry-run" and not DRY_RUN:
+    sys.exit(
+        "the confirmatory stream is the dry run's stand-in 'dry-run': snakemake -n only"
+    )
 CONFIRM_MODELS = list(CONFIRM["models"]) if CONFIRM is not None else []
+# the seed stream of the UAV study (uav.stream) and of the decision study's UAV parts
+# (decisions.stream): absent, exploratory = the config seed itself (the published runs); a
+# confirmatory rerun names its stream (rsmhp.pipeline.protocol.stream_seed)
+UAV_SEED = _stream_seed(config["seed"], config["uav"].get("stream", "exploratory"))
+DEC_SEED = _stream_seed(
+    config["seed"], config["decisions"].get("stream", "exploratory")
+)
 # the sensitivity map's cells (decisions.map): one job each, wildcard {cell} = r<i>c<j>
 MAP_CELLS = [c.name for c in _map_cells(config["decisions"]["map"])]
 # the long-horizon study's (model, H) jobs (horizon.uav)

@@ -101,7 +101,7 @@ rule decisions_uav:
         runs=lambda w: model_runs(
             DEC["uav"]["runs"], SPLIT["decisions_uav"], int(w.chunk)
         ),
-        seed=config["seed"],
+        seed=DEC_SEED,
         families=DEC_UAV_FAMILIES,
         code=code_digest("workflow/scripts/decisions_uav.py", DEC_UAV_FAMILIES),
     script:
@@ -161,7 +161,7 @@ rule decisions_map_cell:
             "track_loss_error",
         ),
         scoring=UAV_SCORING,
-        seed=config["seed"],
+        seed=DEC_SEED,
         families=DEC_MAP_FAMILIES,
         code=code_digest("workflow/scripts/decisions_map_cell.py", DEC_MAP_FAMILIES),
     # closed-loop runs go through the run store (config run_store: the script reads it,
@@ -197,7 +197,7 @@ rule decisions_uav_summary:
     params:
         cfg=canonical({**DEC, "uav": DEC_UAV}),
         base_limited=config["uav"]["sensor"]["footprint_radius"] is not None,
-        seed=config["seed"],
+        seed=DEC_SEED,
         code=code_digest("workflow/scripts/decisions_uav_summary.py"),
     script:
         "../scripts/decisions_uav_summary.py"

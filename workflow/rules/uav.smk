@@ -54,7 +54,7 @@ rule uav_simulate:
         uav=pick(UAV, *UAV_MODEL_KEYS),
         method=lambda wc: UAV_SPECS[wc.method].spec(),
         runs=lambda wc: chunk_runs(UAV["runs"], len(UAV_CHUNKS), int(wc.chunk)),
-        seed=config["seed"],
+        seed=UAV_SEED,
         families=lambda wc: families_of([UAV_SPECS[wc.method]]),
         code=lambda wc: code_digest(
             "workflow/scripts/uav_simulate.py", families_of([UAV_SPECS[wc.method]])
@@ -98,7 +98,7 @@ rule uav_collect:
         runs=UAV["runs"],
         chunks=len(UAV_CHUNKS),
         steps=UAV["scenario"]["steps"],
-        seed=config["seed"],
+        seed=UAV_SEED,
         code=code_digest("workflow/scripts/uav_collect.py"),
     script:
         "../scripts/uav_collect.py"
@@ -126,7 +126,7 @@ rule uav_summary:
     params:
         analysis=canonical(UAV["analysis"]),
         setting=pick(UAV, *UAV_MODEL_KEYS),
-        seed=config["seed"],
+        seed=UAV_SEED,
         methods=UAV_METHODS,
         runs=UAV["runs"],
         code=code_digest("workflow/scripts/uav_summary.py"),
@@ -155,7 +155,7 @@ rule uav_figures:
     params:
         methods=UAV_METHODS,
         runs=UAV["runs"],
-        seed=config["seed"],
+        seed=UAV_SEED,
         code=code_digest("workflow/scripts/uav_figures.py"),
     script:
         "../scripts/uav_figures.py"
@@ -179,7 +179,7 @@ rule uav_recording:
         uav=pick(UAV, *UAV_MODEL_KEYS),
         methods=[s.spec() for s in UAV_SPECS.values()],
         max_hypotheses=UAV["recording"]["max_hypotheses"],
-        seed=config["seed"],
+        seed=UAV_SEED,
         families=UAV_FAMILIES,
         code=code_digest("workflow/scripts/uav_recording.py", UAV_FAMILIES),
     script:

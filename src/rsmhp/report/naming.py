@@ -46,6 +46,7 @@ def depth_name(label: str, plan_depth: float | None, rollout: str = "pursuit",
     if rollout not in ROLLOUT_POLICIES:
         raise ValueError(f"rollout: {rollout!r} (allowed: {', '.join(ROLLOUT_POLICIES)})")
     depth = fmt(d, 3)
+    d = float(depth)  # decide on the depth as printed: 1.999 reads 2.00, not a rollout
     if short:
         return f"{label}, depth {depth}" + (": one-step rollout" if d < ROLLOUT_DEPTH else "")
     if d < ROLLOUT_DEPTH:
