@@ -259,11 +259,11 @@ def test_the_restarts_are_the_same_with_the_pursuit_start():
             for r in (0, 3)
         ]
         got[start] = plans[1]
-        assert plans[1].diagnostics["restart"] in (0.0, 1.0, 2.0, 3.0)
         assert plans[1].cost_warm == plans[0].cost_warm  # the first optimisation's start
         got[start, "rest"] = (plans[1].work - plans[0].work, plans[1].nit - plans[0].nit)
     assert got["warm", "rest"] == got["pursuit", "rest"]
-    if got["warm"].diagnostics["restart"] > 0 and got["pursuit"].diagnostics["restart"] > 0:
+    won = (got["warm"].diagnostics["restart"], got["pursuit"].diagnostics["restart"])
+    if won[0] == won[1] > 0:  # the same restart won from either start: the same optimisation
         np.testing.assert_array_equal(got["warm"].controls, got["pursuit"].controls)
 
 
