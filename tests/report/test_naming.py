@@ -84,3 +84,18 @@ def test_the_pursuit_policy_alone_is_not_named_by_a_depth():
              "run": r, "error": e + r, "plan_depth": d}
             for r in range(3) for m, e, d in methods]  # fmt: skip
     assert best_family(pd.DataFrame(rows)).cells["best_label"].iloc[0] == "pursuit policy"
+
+
+def test_a_setup_label_carries_a_tree_search_claims_depth():
+    from rsmhp.report.findings import named_setup
+    from rsmhp.report.ledger import Claim, KeyNumber
+
+    words = f"On 'paper', the tuned {depth_name('tree search', 1.2)} member tracks better"
+    c = Claim("FR-3-paper", words, "p", KeyNumber("d", -1.0, -2.0, -0.5, null=0.0),
+              "supported", "rule: supported if the CI lies below 0")  # fmt: skip
+    assert named_setup("UAV paper", c) == (
+        "UAV paper (plan depth 1.20: a one-step rollout over the pursuit policy)"
+    )
+    other = Claim("FR-1-paper", "tuned RQMC tracks better", "p",
+                  KeyNumber("d", -1.0, -2.0, -0.5, null=0.0), "supported", "rule")  # fmt: skip
+    assert named_setup("UAV paper", other) == "UAV paper"

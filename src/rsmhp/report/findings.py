@@ -215,6 +215,13 @@ def _ids(js: Sequence[Judgement]) -> str:
     return ", ".join(j.statement.id for j in js)
 
 
+def named_setup(label: str, c: Claim) -> str:
+    """A setup's label with the measured plan depth of a tree-search claim beside it
+    (:func:`rsmhp.report.naming.depth_of`): ``UAV paper (plan depth 1.20: ...)``."""
+    depth = depth_of(c.claim)
+    return f"{label} ({depth})" if depth else label
+
+
 def _claim_phrase(c: Claim, appendix: str) -> str:
     return f"{link(c.id, appendix)} {key_text(c)}, {verdict_text(c)}"
 
@@ -316,7 +323,7 @@ def found_values(
         if not got:
             return ""
         inner = "; ".join(
-            f"{lab}: {_claim_phrase(c, appendix)}"
+            f"{named_setup(lab, c)}: {_claim_phrase(c, appendix)}"
             + (" " + WORDS("contrary_inline", text=c.contrary) if c.contrary else "")
             for lab, c in got
         )

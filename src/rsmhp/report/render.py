@@ -31,6 +31,7 @@ from rsmhp.report.findings import (
     key_text,
     link,
     main_rows,
+    named_setup,
     other_streams,
     verdict_text,
 )
@@ -174,7 +175,8 @@ def glance_table(
         lines += ["", WORDS("ours_header"), "|---|---|---|"]
         for m in ours:
             per = "; ".join(
-                f"{lab}: {verdict_text(by_id[i])} ({escape(key_text(by_id[i]))})"
+                f"{named_setup(lab, by_id[i])}: {verdict_text(by_id[i])} "
+                f"({escape(key_text(by_id[i]))})"
                 + (f"; contrary: {escape(by_id[i].contrary)}" if by_id[i].contrary else "")
                 for lab, i in m.setups
                 if i in by_id
