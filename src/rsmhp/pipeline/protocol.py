@@ -77,6 +77,7 @@ __all__ = [
     "Configuration",
     "Preregistration",
     "budget_cost",
+    "candidate_stats",
     "candidates",
     "confirm_plan",
     "file_commit",
@@ -253,6 +254,24 @@ def budget_cost(timed_ms, loop_ms):
     return np.fmax(timed_ms, loop_ms)
 
 
+def candidate_stats(quality: pd.DataFrame, timing: pd.DataFrame) -> pd.DataFrame:
+    """What the tuning rule reads of each candidate, indexed by (``model``, ``config``):
+    ``mean_error`` (mean over its closed-loop runs), ``work_per_step`` (median),
+    ``closed_loop_ms`` (mean planning ms per step of its runs), ``timing_ms`` (median of its
+    interleaved timing) and ``cost_ms`` = :func:`budget_cost` of the two; NaN where a
+    candidate has no rows of one kind. ``quality`` and ``timing`` as :func:`select` takes
+    them."""
+    q = quality.groupby(["model", "config"], sort=False).agg(
+        mean_error=("mean_error", "mean"),
+        work_per_step=("work_per_step", "median"),
+        closed_loop_ms=("plan_ms", "mean"),
+    )
+    t = timing.groupby(["model", "config"], sort=False)["ms"].median().rename("timing_ms")
+    out = q.join(t, how="outer")
+    out["cost_ms"] = budget_cost(out["timing_ms"], out["closed_loop_ms"])
+    return out
+
+
 #: the columns of the tuning selection (:func:`select`)
 SELECTION_COLUMNS = [
     "model",
@@ -290,21 +309,14 @@ def select(
         raise ValueError(f"tuning: closed-loop rows lack columns {sorted(missing)}")
     order = {c.name: i for i, c in enumerate(configs)}
     by_name = {c.name: c for c in configs}
-    q = quality.groupby(["model", "config"], sort=False).agg(
-        mean_error=("mean_error", "mean"),
-        work_per_step=("work_per_step", "median"),
-        closed_loop_ms=("plan_ms", "mean"),
-    )
-    t = timing.groupby(["model", "config"], sort=False)["ms"].median()
+    q = candidate_stats(quality, timing)
     rows = []
     for model in dict.fromkeys(quality["model"]):
         for c in configs:
-            for what, table in (("closed-loop", q), ("timing", t)):
-                if (model, c.name) not in table.index:
+            for what, col in (("closed-loop", "mean_error"), ("timing", "timing_ms")):
+                if (model, c.name) not in q.index or pd.isna(q.loc[(model, c.name), col]):
                     raise ValueError(f"tuning: no {what} rows of {c.name!r} on {model!r}")
-        loop = q["closed_loop_ms"]
-        cost = {c.name: float(budget_cost(t.loc[(model, c.name)], loop.loc[(model, c.name)]))
-                for c in configs}  # fmt: skip
+        cost = {c.name: float(q.loc[(model, c.name), "cost_ms"]) for c in configs}
         for family in dict.fromkeys(c.family for c in configs):
             fam = [c.name for c in configs if c.family == family]
             for b in budgets_ms:
@@ -333,7 +345,7 @@ def select(
                         "plan_ms": cost[best],
                         "work_per_step": float(q.loc[(model, best), "work_per_step"]),
                         "mean_error": float(q.loc[(model, best), "mean_error"]),
-                        "timing_ms": float(t.loc[(model, best)]),
+                        "timing_ms": float(q.loc[(model, best), "timing_ms"]),
                         "closed_loop_ms": float(q.loc[(model, best), "closed_loop_ms"]),
                         "fitting": len(fit),
                     }

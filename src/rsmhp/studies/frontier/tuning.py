@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from rsmhp.core.stats import mean_ci
-from rsmhp.pipeline.protocol import Configuration, budget_cost
+from rsmhp.pipeline.protocol import Configuration, candidate_stats
 
 __all__ = ["CANDIDATE_COLUMNS", "DEPTH_TABLE_COLUMNS", "candidate_table", "depth_table"]
 
@@ -45,27 +45,23 @@ def candidate_table(
     closed-loop rows in ``quality`` (columns ``model``, ``config``, ``run``, ``mean_error``,
     ``plan_ms``, ``work_per_step``, ``plan_depth``) and timing rows in ``timing`` (``model``,
     ``config``, ``ms``); in model order, then the configurations' order."""
-    q = quality.groupby(["model", "config"], sort=False).agg(
-        runs=("run", "nunique"),
-        mean_error=("mean_error", "mean"),
-        closed_loop_ms=("plan_ms", "mean"),
-        work_per_step=("work_per_step", "median"),
-        plan_depth=("plan_depth", "mean"),
+    q = candidate_stats(quality, timing).join(
+        quality.groupby(["model", "config"], sort=False).agg(
+            runs=("run", "nunique"), plan_depth=("plan_depth", "mean")
+        )
     )
-    t = timing.groupby(["model", "config"], sort=False)["ms"].median()
     rows = []
     for model in dict.fromkeys(quality["model"]):
         for c in configs:
-            if (model, c.name) not in q.index:
+            if (model, c.name) not in q.index or pd.isna(q.loc[(model, c.name), "mean_error"]):
                 continue
             r = q.loc[(model, c.name)]
-            timed = float(t.get((model, c.name), np.nan))
             rows.append({
                 "model": model, "config": c.name, "family": c.family, "member": c.member,
                 "maxiter": c.maxiter, "restarts": c.restarts, "start": c.start,
                 "runs": int(r["runs"]), "mean_error": float(r["mean_error"]),
-                "cost_ms": float(budget_cost(timed, float(r["closed_loop_ms"]))),
-                "timing_ms": timed, "closed_loop_ms": float(r["closed_loop_ms"]),
+                "cost_ms": float(r["cost_ms"]),
+                "timing_ms": float(r["timing_ms"]), "closed_loop_ms": float(r["closed_loop_ms"]),
                 "work_per_step": float(r["work_per_step"]), "plan_depth": float(r["plan_depth"]),
             })  # fmt: skip
     return pd.DataFrame(rows, columns=CANDIDATE_COLUMNS)

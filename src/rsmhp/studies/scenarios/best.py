@@ -63,6 +63,7 @@ __all__ = [
     "budget_runs",
     "footprint_label",
     "horizon_runs",
+    "rollout_of",
     "scenario_runs",
     "short_label",
 ]
@@ -233,7 +234,7 @@ def best_family(runs: pd.DataFrame, level: float = 0.95) -> Best:
             "group": group, "model": model, "value": value, "runs": int(wide.shape[0]),
             "methods": int(wide.shape[1]), "best": best,
             "best_member": first.loc[best, "member"],
-            "best_label": depth_name(short_label(member), depth, _rollout(member), short=True),
+            "best_label": depth_name(short_label(member), depth, rollout_of(member), short=True),
             "best_family": first.loc[best, "family"], "best_depth": depth,
             "best_mean": float(means[best]), "runner_up": second["method"],
             "runner_up_member": second["member"], "runner_up_mean": second["mean"],
@@ -245,7 +246,7 @@ def best_family(runs: pd.DataFrame, level: float = 0.95) -> Best:
                 pd.DataFrame(paired, columns=PAIRED_COLUMNS))  # fmt: skip
 
 
-def _rollout(member: str) -> str:
+def rollout_of(member: str) -> str:
     """The rollout policy of a tree-search member (``pursuit`` for any other method: only a
     tree search has a measured plan depth to name it by)."""
     try:

@@ -21,7 +21,7 @@ from rsmhp.report.naming import depth_name
 from rsmhp.report.palette import method_label
 from rsmhp.report.templates import render
 from rsmhp.studies.scenarios import TABLES
-from rsmhp.studies.scenarios.best import BUDGET, GROUPS, HORIZON, SCENARIO
+from rsmhp.studies.scenarios.best import BUDGET, GROUPS, HORIZON, SCENARIO, rollout_of
 from rsmhp.studies.scenarios.summarise import ALL_GROUP
 
 __all__ = [
@@ -55,11 +55,6 @@ def config_label(method: str, member: str) -> str:
     return label
 
 
-def _rollout(member: str) -> str:
-    """A tree-search member's rollout policy (``pursuit`` for any other method)."""
-    return str(getattr(methods.from_name(str(member)), "rollout", "pursuit"))
-
-
 def _axis_text(group: str, value: float) -> str:
     text = param_text(value)
     return {BUDGET: f"{text} ms", HORIZON: f"H = {text}", SCENARIO: f"q = {text}"}.get(group, text)
@@ -85,7 +80,7 @@ def best_table(best: pd.DataFrame, paired: pd.DataFrame) -> str:
             "column": [_axis_text(g, a) for g, a in zip(best["group"], best["value"], strict=True)],
             "runs": best["runs"].astype(int),
             "methods": best["methods"].astype(int),
-            "best": [depth_name(config_label(m, b), d, _rollout(b)) for m, b, d in
+            "best": [depth_name(config_label(m, b), d, rollout_of(b)) for m, b, d in
                      zip(best["best"], best["best_member"], best["best_depth"], strict=True)],
             "its mean error (m)": best["best_mean"],
             "runner-up": [config_label(m, b) for m, b in
